@@ -1,0 +1,105 @@
+#pragma once
+/// \file
+/// Reading and writing trajectory files. Formats (docs/formats.md has the full reference):
+///
+/// | Format | Layout of a row                                        | Separator | Stamps        |
+/// |--------|--------------------------------------------------------|-----------|---------------|
+/// | tum    | t x y z qx qy qz qw                                     | spaces    | seconds       |
+/// | tumv   | t x y z qx qy qz qw vx vy vz                            | spaces    | seconds       |
+/// | euroc  | t p(3) q(w x y z) [v(3) [bw(3) ba(3)]], `#` header      | commas    | nanoseconds   |
+/// | kitti  | r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz            | spaces    | times file or none |
+/// | vins   | t p(3) q(w x y z) [v(3)], trailing comma allowed         | commas    | nanoseconds   |
+/// | csv    | any, described by a ColumnMap (`--columns`)             | either    | as mapped     |
+///
+/// Lines starting with `#` are comments; blank lines are skipped; one header row of names (no
+/// number in it) is skipped. Quaternions are stored as read and normalised when a rotation is
+/// formed, as evo does; a quaternion of (near) zero norm is an error. Stamps are kept in file order,
+/// duplicates included (evo keeps them too). Every problem throws cheval::InputError with
+/// `path:line:column`.
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cheval/traj/trajectory.h"
+
+namespace cheval::traj {
+
+/// Trajectory file formats. kAuto decides from the extension and the content.
+enum class Format { kAuto, kTum, kTumV, kEuroc, kKitti, kVins, kCsv };
+
+/// Lower-case name of a format ("auto", "tum", "tumv", "euroc", "kitti", "vins", "csv").
+std::string_view ToString(Format format);
+/// Parses a format name; nullopt if unknown.
+std::optional<Format> FormatFromString(std::string_view name);
+
+/// What one column of a generic CSV/whitespace file holds.
+enum class ColumnRole {
+  kSkip,
+  kTimeSeconds, kTimeMilliseconds, kTimeMicroseconds, kTimeNanoseconds,
+  kPx, kPy, kPz,
+  kQx, kQy, kQz, kQw,
+  kRoll, kPitch, kYaw,  ///< radians; R = Rz(yaw)·Ry(pitch)·Rx(roll)
+  kVx, kVy, kVz,        ///< world frame, m/s
+  kWx, kWy, kWz,        ///< body frame, rad/s
+};
+
+/// A column map for the generic `csv` format: the role of each column, left to right; columns
+/// after the last one listed are ignored. Written as a comma-separated list of role names:
+/// `t` (seconds), `t_ms`, `t_us`, `t_ns`, `px py pz`, `qx qy qz qw`, `roll pitch yaw`, `vx vy vz`,
+/// `wx wy wz`, and `_` (or `skip`) for a column to ignore, e.g. `t_ns,px,py,pz,qw,qx,qy,qz`.
+struct ColumnMap {
+  std::vector<ColumnRole> roles;
+
+  /// Parses and validates a map: exactly one time column; px, py, pz; either none or all of qx..qw,
+  /// either none or all of roll/pitch/yaw (not both); none or all of vx..vz and of wx..wz; no role
+  /// twice. Throws UsageError naming the problem.
+  static ColumnMap Parse(std::string_view spec);
+  /// The map written back as a spec string.
+  std::string ToString() const;
+};
+
+/// Options of ReadTrajectory.
+struct ReadOptions {
+  Format format = Format::kAuto;
+  /// Required for Format::kCsv; ignored otherwise.
+  std::optional<ColumnMap> columns;
+  /// KITTI only: a file with one stamp (seconds) per pose. Without it, KITTI poses have no stamps.
+  std::string kitti_times_path;
+};
+
+/// Decides the format of a file from its name and content (the text, not a path): `#timestamp`
+/// header with commas -> euroc; comma-separated integer nanosecond stamps with 8 or 11 values ->
+/// vins; whitespace-separated rows of 8 -> tum, 11 -> tumv, 12 -> kitti. Throws InputError
+/// explaining what was seen when no format fits (suggesting `--format csv --columns ...`).
+Format DetectFormat(const std::string& path, std::string_view content);
+
+/// Reads a trajectory file. Throws InputError (`path:line:column: error: ...`) on any problem:
+/// missing or unreadable file, empty file, wrong field count, non-number, NaN/Inf, truncated last
+/// line, zero-norm quaternion, a non-rotation KITTI matrix, a KITTI times file of another length.
+/// If `format_read` is given, it receives the format used (the detected one for kAuto).
+Trajectory ReadTrajectory(const std::string& path, const ReadOptions& options = {}, Format* format_read = nullptr);
+
+/// Parses trajectory text already in memory; `path` is used in messages and for detection.
+Trajectory ParseTrajectory(std::string_view content, const std::string& path, const ReadOptions& options = {},
+                           Format* format_read = nullptr);
+
+/// Reads a file of one stamp per line (seconds, e.g. a KITTI times file); InputError on problems.
+std::vector<int64_t> ReadStampsFile(const std::string& path);
+
+/// The text of `trajectory` in `format` (kTum, kTumV, kEuroc or kKitti). Numbers are written in the
+/// shortest form that reads back to the same double; stamps as seconds with nine decimals (TUM) or
+/// integer nanoseconds (EuRoC). Quaternions are written as read. Throws ComputeError if the
+/// trajectory lacks what the format needs (orientation; velocity for tumv) and UsageError for a
+/// format that cannot be written.
+std::string FormatTrajectory(const TrajectoryView& trajectory, Format format);
+
+/// Writes FormatTrajectory() to `path` atomically: a temporary file beside it is written, flushed
+/// and renamed, so a failure leaves no partial file. Throws OutputError.
+void WriteTrajectory(const std::string& path, const TrajectoryView& trajectory, Format format);
+
+/// Writes `text` to `path` atomically (as WriteTrajectory). Throws OutputError.
+void WriteFileAtomically(const std::string& path, std::string_view text);
+
+}  // namespace cheval::traj

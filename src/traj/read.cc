@@ -1,0 +1,557 @@
+// Trajectory readers: every format is described as a row layout (separator, role of each column,
+// accepted field counts) and read by one scanner, so all formats share the same checks and the
+// same error messages.
+#include <algorithm>
+#include <cerrno>
+#include <cctype>
+#include <limits>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "cheval/common/error.h"
+#include "cheval/traj/io.h"
+#include "cheval/traj/stamp.h"
+
+namespace cheval::traj {
+namespace {
+
+// n = q·q below this is a zero quaternion (evo's threshold for "identity", 4·machine epsilon).
+constexpr double kZeroQuaternionNormSquared = 8.881784197001252e-16;
+
+struct Field {
+  std::string_view text;
+  int64_t column;  // 1-based column of the first character
+};
+
+// Walks over the lines of a text, skipping blank lines and `#` comments.
+class LineScanner {
+ public:
+  explicit LineScanner(std::string_view content) : content_(content) {}
+
+  // Moves to the next data line; false at the end of the text.
+  bool Next() {
+    while (position_ < content_.size()) {
+      const size_t end = content_.find('\n', position_);
+      has_newline_ = end != std::string_view::npos;
+      const size_t stop = has_newline_ ? end : content_.size();
+      line_ = content_.substr(position_, stop - position_);
+      if (!line_.empty() && line_.back() == '\r') line_.remove_suffix(1);
+      position_ = has_newline_ ? stop + 1 : stop;
+      ++line_number_;
+      const size_t first = line_.find_first_not_of(" \t");
+      if (first == std::string_view::npos) continue;  // blank
+      if (line_[first] == '#') {
+        if (first_comment_.empty()) first_comment_ = line_.substr(first);
+        continue;
+      }
+      return true;
+    }
+    return false;
+  }
+
+  std::string_view line() const { return line_; }
+  int64_t line_number() const { return line_number_; }
+  // False only for a last line that is not terminated by a newline.
+  bool has_newline() const { return has_newline_; }
+  std::string_view first_comment() const { return first_comment_; }
+
+  // Splits the current line at `separator` (',' or ' ' meaning runs of spaces/tabs), trimming
+  // spaces and tabs around comma-separated fields. One empty field after a final comma is dropped.
+  void Split(char separator, std::vector<Field>* fields) const {
+    fields->clear();
+    const std::string_view line = line_;
+    if (separator == ',') {
+      size_t start = 0;
+      while (true) {
+        const size_t comma = line.find(',', start);
+        const size_t stop = comma == std::string_view::npos ? line.size() : comma;
+        size_t b = start, e = stop;
+        while (b < e && (line[b] == ' ' || line[b] == '\t')) ++b;
+        while (e > b && (line[e - 1] == ' ' || line[e - 1] == '\t')) --e;
+        fields->push_back({line.substr(b, e - b), static_cast<int64_t>(b + 1)});
+        if (comma == std::string_view::npos) break;
+        start = comma + 1;
+      }
+      if (fields->size() > 1 && fields->back().text.empty()) fields->pop_back();
+    } else {
+      size_t i = 0;
+      while (i < line.size()) {
+        while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+        if (i >= line.size()) break;
+        const size_t b = i;
+        while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
+        fields->push_back({line.substr(b, i - b), static_cast<int64_t>(b + 1)});
+      }
+    }
+  }
+
+  // One past the last character of the current line, as a 1-based column.
+  int64_t end_column() const { return static_cast<int64_t>(line_.size()) + 1; }
+
+ private:
+  std::string_view content_;
+  size_t position_ = 0;
+  std::string_view line_;
+  int64_t line_number_ = 0;
+  bool has_newline_ = true;
+  std::string_view first_comment_;
+};
+
+// A field is name-like (part of a header row) when it starts with a letter, '_' or a quote.
+bool LooksLikeName(std::string_view text) {
+  if (text.empty()) return false;
+  const char c = text.front();
+  return std::isalpha(static_cast<unsigned char>(c)) || c == '_' || c == '"' || c == '\'';
+}
+
+bool IsHeaderRow(const std::vector<Field>& fields) {
+  if (fields.empty()) return false;
+  for (const Field& f : fields) {
+    // "nan"/"inf" look like names but are numbers; a header never consists of them alone.
+    if (!LooksLikeName(f.text) || f.text == "nan" || f.text == "inf" || f.text == "NaN") return false;
+  }
+  return true;
+}
+
+// Parses a double with std::from_chars; accepts a leading '+'. nullopt on anything else.
+std::optional<double> ParseDouble(std::string_view text) {
+  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+  if (text.empty() || text.front() == '+' || (text.front() == '-' && text.size() > 1 && text[1] == '+')) {
+    return std::nullopt;
+  }
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec == std::errc::result_out_of_range) return std::numeric_limits<double>::infinity();
+  if (ec != std::errc() || end != text.data() + text.size()) return std::nullopt;
+  return value;
+}
+
+// A row layout: what each column holds, how many fields a row may have, and names for messages.
+struct Layout {
+  Format format = Format::kTum;
+  char separator = ' ';
+  std::vector<ColumnRole> roles;      // role per column (kitti: unused)
+  std::vector<std::string> names;     // display name per column, for messages
+  std::vector<size_t> field_counts;   // accepted counts; empty = at least roles.size()
+  bool kitti = false;
+  bool velocity = false;
+  bool angular_velocity = false;
+  OrientationKind orientation = OrientationKind::kQuaternion;
+  bool euler = false;
+  size_t first_quaternion_field = 0;  // for the zero-norm message
+};
+
+std::vector<std::string> Split(std::string_view names) {
+  std::vector<std::string> out;
+  std::istringstream in{std::string(names)};
+  for (std::string name; in >> name;) out.push_back(name);
+  return out;
+}
+
+std::vector<ColumnRole> RolesOf(std::string_view spec) { return ColumnMap::Parse(spec).roles; }
+
+Layout MakeLayout(const ColumnMap& map, char separator, Format format) {
+  Layout layout;
+  layout.format = format;
+  layout.separator = separator;
+  layout.roles = map.roles;
+  std::string names = map.ToString();
+  std::replace(names.begin(), names.end(), ',', ' ');
+  layout.names = Split(names);
+  bool quaternion = false;
+  for (size_t i = 0; i < map.roles.size(); ++i) {
+    const ColumnRole r = map.roles[i];
+    layout.velocity = layout.velocity || r == ColumnRole::kVx;
+    layout.angular_velocity = layout.angular_velocity || r == ColumnRole::kWx;
+    layout.euler = layout.euler || r == ColumnRole::kRoll;
+    if (r == ColumnRole::kQx || r == ColumnRole::kQy || r == ColumnRole::kQz || r == ColumnRole::kQw) {
+      if (!quaternion) layout.first_quaternion_field = i;
+      quaternion = true;
+    }
+  }
+  layout.orientation = (quaternion || layout.euler) ? OrientationKind::kQuaternion : OrientationKind::kNone;
+  return layout;
+}
+
+Layout TumLayout(bool velocity) {
+  Layout layout = MakeLayout(ColumnMap{RolesOf(velocity ? "t,px,py,pz,qx,qy,qz,qw,vx,vy,vz" : "t,px,py,pz,qx,qy,qz,qw")},
+                             ' ', velocity ? Format::kTumV : Format::kTum);
+  layout.names = Split(velocity ? "t x y z qx qy qz qw vx vy vz" : "t x y z qx qy qz qw");
+  layout.field_counts = {layout.roles.size()};
+  return layout;
+}
+
+// EuRoC and VINS share the row layout t_ns p q(w first) [v ...]; `fields` is the first row's count.
+Layout NanosecondCsvLayout(Format format, bool velocity) {
+  Layout layout = MakeLayout(
+      ColumnMap{RolesOf(velocity ? "t_ns,px,py,pz,qw,qx,qy,qz,vx,vy,vz" : "t_ns,px,py,pz,qw,qx,qy,qz")}, ',', format);
+  layout.names = Split("t_ns px py pz qw qx qy qz vx vy vz bwx bwy bwz bax bay baz");
+  return layout;
+}
+
+Layout KittiLayout() {
+  Layout layout;
+  layout.format = Format::kKitti;
+  layout.separator = ' ';
+  layout.kitti = true;
+  layout.orientation = OrientationKind::kMatrix;
+  layout.names = Split("r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz");
+  layout.field_counts = {12};
+  return layout;
+}
+
+std::string JoinNames(const std::vector<std::string>& names, size_t count) {
+  std::string out;
+  for (size_t i = 0; i < count && i < names.size(); ++i) {
+    if (i > 0) out += ' ';
+    out += names[i];
+  }
+  return out;
+}
+
+std::string FieldName(const Layout& layout, size_t index) {
+  return index < layout.names.size() ? fmt::format("field {} ({})", index + 1, layout.names[index])
+                                     : fmt::format("field {}", index + 1);
+}
+
+Eigen::Quaterniond QuaternionFromRollPitchYaw(double roll, double pitch, double yaw) {
+  return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX());
+}
+
+class Reader {
+ public:
+  Reader(std::string_view content, std::string path)
+      : scanner_(content), content_size_(content.size()), path_(std::move(path)) {}
+
+  [[noreturn]] void Fail(int64_t column, const std::string& what) const {
+    throw InputError(path_, scanner_.line_number(), column, what);
+  }
+
+  // Reads all rows with `layout`. For euroc/vins the first row fixes the field count (and whether
+  // there is velocity).
+  Trajectory Read(Layout layout) {
+    bool first_row = true;
+    Trajectory trajectory;
+    std::vector<Field> fields;
+    while (scanner_.Next()) {
+      scanner_.Split(layout.separator, &fields);
+      if (first_row && IsHeaderRow(fields)) continue;  // one header row of names, before any data
+      if (first_row) {
+        layout = FixLayoutFromFirstRow(layout, fields.size());
+        trajectory = Trajectory(Channels{layout.orientation, layout.velocity, layout.angular_velocity, true});
+        trajectory.Reserve(EstimateRows());
+        first_row = false;
+      }
+      CheckFieldCount(layout, fields);
+      ParseRow(layout, fields, &trajectory);
+    }
+    if (first_row) {
+      const std::string expected = layout.kitti || layout.format != Format::kCsv
+                                       ? JoinNames(layout.names, layout.field_counts.empty() ? layout.names.size()
+                                                                                          : layout.field_counts[0])
+                                       : JoinNames(layout.names, layout.names.size());
+      throw InputError(path_, scanner_.line_number() + 1, 1,
+                       fmt::format("no poses: expected at least one row of data ({})", expected));
+    }
+    return trajectory;
+  }
+
+  std::string_view first_comment() const { return scanner_.first_comment(); }
+
+ private:
+  // Rows in the file, guessed from the first data line's length (only to reserve memory).
+  Eigen::Index EstimateRows() const {
+    return static_cast<Eigen::Index>(content_size_ / (scanner_.line().size() + 1) + 1);
+  }
+
+  Layout FixLayoutFromFirstRow(Layout layout, size_t count) {
+    if (layout.format == Format::kEuroc && !layout.kitti && layout.field_counts.empty()) {
+      if (count == 8 || count >= 11) {
+        layout = NanosecondCsvLayout(Format::kEuroc, count >= 11);
+        layout.field_counts = {count};
+      } else {
+        Fail(scanner_.end_column(),
+             fmt::format("expected 8 fields (t_ns px py pz qw qx qy qz) or at least 11 (… vx vy vz), got {}", count));
+      }
+    } else if (layout.format == Format::kVins && layout.field_counts.empty()) {
+      if (count == 8 || count == 11) {
+        layout = NanosecondCsvLayout(Format::kVins, count == 11);
+        layout.field_counts = {count};
+      } else {
+        Fail(scanner_.end_column(),
+             fmt::format("expected 8 fields (t_ns px py pz qw qx qy qz) or 11 (… vx vy vz), got {}", count));
+      }
+    }
+    return layout;
+  }
+
+  void CheckFieldCount(const Layout& layout, const std::vector<Field>& fields) const {
+    const size_t count = fields.size();
+    bool ok = false;
+    if (layout.field_counts.empty()) {
+      ok = count >= layout.roles.size();
+    } else {
+      for (size_t c : layout.field_counts) ok = ok || c == count;
+    }
+    if (ok) return;
+    const size_t expected = layout.field_counts.empty() ? layout.roles.size() : layout.field_counts.front();
+    std::string what = layout.field_counts.empty()
+                           ? fmt::format("expected at least {} fields ({}), got {}", expected,
+                                         JoinNames(layout.names, expected), count)
+                           : fmt::format("expected {} fields ({}), got {}", expected,
+                                         JoinNames(layout.names, expected), count);
+    if (!scanner_.has_newline() && count < expected) {
+      what = "truncated last line (no newline at end of file): " + what;
+    }
+    const int64_t column = count > expected ? fields[expected].column : scanner_.end_column();
+    Fail(column, what);
+  }
+
+  double Number(const Layout& layout, const std::vector<Field>& fields, size_t index) const {
+    const Field& field = fields[index];
+    if (field.text.empty()) Fail(field.column, fmt::format("{} is empty; expected a number", FieldName(layout, index)));
+    const std::optional<double> value = ParseDouble(field.text);
+    if (!value) {
+      Fail(field.column, fmt::format("expected a number for {}, got '{}'", FieldName(layout, index), field.text));
+    }
+    if (!std::isfinite(*value)) {
+      Fail(field.column, fmt::format("{} is '{}'; expected a finite number", FieldName(layout, index), field.text));
+    }
+    return *value;
+  }
+
+  int64_t Stamp(const Layout& layout, const std::vector<Field>& fields, size_t index, ColumnRole role) const {
+    const Field& field = fields[index];
+    int scale = 9;
+    const char* unit = "seconds";
+    switch (role) {
+      case ColumnRole::kTimeMilliseconds: scale = 6, unit = "milliseconds"; break;
+      case ColumnRole::kTimeMicroseconds: scale = 3, unit = "microseconds"; break;
+      case ColumnRole::kTimeNanoseconds: scale = 0, unit = "nanoseconds"; break;
+      default: break;
+    }
+    const bool integer = role == ColumnRole::kTimeNanoseconds;
+    const StampParseResult r = ParseDecimalStamp(field.text, scale, integer);
+    if (!r.error) return r.value;
+    switch (*r.error) {
+      case StampParseError::kNotANumber:
+        Fail(field.column, fmt::format("expected a time stamp in {} for {}, got '{}'", unit,
+                                       FieldName(layout, index), field.text));
+      case StampParseError::kOutOfRange:
+        Fail(field.column, fmt::format("time stamp '{}' in {} is out of range (int64 nanoseconds, about ±292 years)",
+                                       field.text, FieldName(layout, index)));
+      case StampParseError::kNotAnInteger:
+        Fail(field.column, fmt::format("expected an integer number of nanoseconds for {}, got '{}'",
+                                       FieldName(layout, index), field.text));
+    }
+    Fail(field.column, "bad time stamp");
+  }
+
+  void ParseRow(const Layout& layout, const std::vector<Field>& fields, Trajectory* trajectory) {
+    if (layout.kitti) return ParseKittiRow(layout, fields, trajectory);
+    int64_t stamp = 0;
+    double p[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, euler[3] = {0, 0, 0}, v[3] = {0, 0, 0}, w[3] = {0, 0, 0};
+    for (size_t i = 0; i < layout.roles.size(); ++i) {
+      const ColumnRole role = layout.roles[i];
+      switch (role) {
+        case ColumnRole::kSkip: break;
+        case ColumnRole::kTimeSeconds:
+        case ColumnRole::kTimeMilliseconds:
+        case ColumnRole::kTimeMicroseconds:
+        case ColumnRole::kTimeNanoseconds: stamp = Stamp(layout, fields, i, role); break;
+        case ColumnRole::kPx: p[0] = Number(layout, fields, i); break;
+        case ColumnRole::kPy: p[1] = Number(layout, fields, i); break;
+        case ColumnRole::kPz: p[2] = Number(layout, fields, i); break;
+        case ColumnRole::kQx: q[0] = Number(layout, fields, i); break;
+        case ColumnRole::kQy: q[1] = Number(layout, fields, i); break;
+        case ColumnRole::kQz: q[2] = Number(layout, fields, i); break;
+        case ColumnRole::kQw: q[3] = Number(layout, fields, i); break;
+        case ColumnRole::kRoll: euler[0] = Number(layout, fields, i); break;
+        case ColumnRole::kPitch: euler[1] = Number(layout, fields, i); break;
+        case ColumnRole::kYaw: euler[2] = Number(layout, fields, i); break;
+        case ColumnRole::kVx: v[0] = Number(layout, fields, i); break;
+        case ColumnRole::kVy: v[1] = Number(layout, fields, i); break;
+        case ColumnRole::kVz: v[2] = Number(layout, fields, i); break;
+        case ColumnRole::kWx: w[0] = Number(layout, fields, i); break;
+        case ColumnRole::kWy: w[1] = Number(layout, fields, i); break;
+        case ColumnRole::kWz: w[2] = Number(layout, fields, i); break;
+      }
+    }
+    if (layout.euler) {
+      const Eigen::Quaterniond rotation = QuaternionFromRollPitchYaw(euler[0], euler[1], euler[2]);
+      q[0] = rotation.x(), q[1] = rotation.y(), q[2] = rotation.z(), q[3] = rotation.w();
+    } else if (layout.orientation == OrientationKind::kQuaternion) {
+      const double n = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+      if (n < kZeroQuaternionNormSquared) {
+        Fail(fields[layout.first_quaternion_field].column,
+             fmt::format("quaternion ({}) has zero norm; expected a rotation", QuaternionNames(layout)));
+      }
+    }
+    trajectory->Append(stamp, p, q, v, w);
+  }
+
+  static std::string QuaternionNames(const Layout& layout) {
+    std::string out;
+    for (size_t i = 0; i < layout.roles.size(); ++i) {
+      const ColumnRole r = layout.roles[i];
+      if (r == ColumnRole::kQx || r == ColumnRole::kQy || r == ColumnRole::kQz || r == ColumnRole::kQw) {
+        if (!out.empty()) out += ' ';
+        out += layout.names[i];
+      }
+    }
+    return out;
+  }
+
+  void ParseKittiRow(const Layout& layout, const std::vector<Field>& fields, Trajectory* trajectory) {
+    double m[12];
+    for (size_t i = 0; i < 12; ++i) m[i] = Number(layout, fields, i);
+    const double rotation[9] = {m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10]};
+    const double position[3] = {m[3], m[7], m[11]};
+    const double det = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(rotation).determinant();
+    // A rotation has determinant 1; KITTI's are off by ~1e-6. 0.1 only rejects what is no rotation.
+    if (!(std::abs(det - 1.0) <= 0.1)) {
+      Fail(fields[0].column,
+           fmt::format("expected a rotation matrix in fields 1-3, 5-7, 9-11 (r00..r22), got determinant {:.6g}", det));
+    }
+    trajectory->Append(trajectory->size() * kNanosecondsPerSecond, position, rotation);
+  }
+
+  LineScanner scanner_;
+  size_t content_size_;
+  std::string path_;
+};
+
+std::string ReadWholeFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw InputError(path, 0, 0, fmt::format("cannot open file: {}", std::strerror(errno)));
+  }
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  if (in.bad()) throw InputError(path, 0, 0, "cannot read file");
+  return std::move(buffer).str();
+}
+
+bool IsIntegerNanoseconds(std::string_view text) {
+  if (text.size() < 13) return false;  // fewer digits cannot be ns since the epoch (1e12 ns = 1000 s)
+  for (char c : text) {
+    if (c < '0' || c > '9') return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Format DetectFormat(const std::string& path, std::string_view content) {
+  LineScanner scanner(content);
+  std::vector<Field> fields;
+  bool header = false;
+  while (scanner.Next()) {
+    const char separator = scanner.line().find(',') != std::string_view::npos ? ',' : ' ';
+    scanner.Split(separator, &fields);
+    if (!header && IsHeaderRow(fields)) {
+      header = true;
+      continue;
+    }
+    const size_t count = fields.size();
+    std::string comment(scanner.first_comment());
+    std::transform(comment.begin(), comment.end(), comment.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (separator == ',') {
+      if (comment.rfind("#timestamp", 0) == 0 || comment.find("p_rs_r") != std::string::npos) return Format::kEuroc;
+      if (!header && IsIntegerNanoseconds(fields[0].text) && (count == 8 || count == 11)) return Format::kVins;
+      throw InputError(path, scanner.line_number(), 1,
+                       fmt::format("cannot detect the format: {} comma-separated fields{}; EuRoC needs a "
+                                   "'#timestamp' header, VINS integer nanosecond stamps and 8 or 11 fields. "
+                                   "Use --format csv --columns ... (e.g. t_ns,px,py,pz,qw,qx,qy,qz)",
+                                   count, header ? " after a header row" : ""));
+    }
+    if (!header) {
+      if (count == 8) return Format::kTum;
+      if (count == 11) return Format::kTumV;
+      if (count == 12) return Format::kKitti;
+    }
+    throw InputError(path, scanner.line_number(), 1,
+                     fmt::format("cannot detect the format: {} space-separated fields{}; expected 8 (tum: t x y z qx "
+                                 "qy qz qw), 11 (tumv: ... vx vy vz) or 12 (kitti). Use --format csv --columns ...",
+                                 count, header ? " after a header row" : ""));
+  }
+  throw InputError(path, scanner.line_number() + 1, 1,
+                   "no poses: expected at least one row of data (the file is empty or only comments)");
+}
+
+Trajectory ParseTrajectory(std::string_view content, const std::string& path, const ReadOptions& options,
+                           Format* format_read) {
+  Format format = options.format;
+  if (format == Format::kAuto) format = DetectFormat(path, content);
+  if (format_read != nullptr) *format_read = format;
+  Layout layout;
+  switch (format) {
+    case Format::kTum: layout = TumLayout(false); break;
+    case Format::kTumV: layout = TumLayout(true); break;
+    case Format::kEuroc: layout = NanosecondCsvLayout(Format::kEuroc, false); layout.field_counts.clear(); break;
+    case Format::kVins: layout = NanosecondCsvLayout(Format::kVins, false); layout.field_counts.clear(); break;
+    case Format::kKitti: layout = KittiLayout(); break;
+    case Format::kCsv: {
+      if (!options.columns) throw UsageError("--format csv needs --columns (e.g. --columns t,px,py,pz,qx,qy,qz,qw)");
+      // The separator is the file's: commas if its first data line has one, else whitespace.
+      LineScanner probe(content);
+      const char separator = probe.Next() && probe.line().find(',') != std::string_view::npos ? ',' : ' ';
+      layout = MakeLayout(*options.columns, separator, Format::kCsv);
+      break;
+    }
+    case Format::kAuto: break;
+  }
+  Reader reader(content, path);
+  Trajectory trajectory = reader.Read(layout);
+  if (format == Format::kKitti) {
+    if (options.kitti_times_path.empty()) {
+      trajectory.SetHasStamps(false);
+    } else {
+      std::vector<int64_t> stamps = ReadStampsFile(options.kitti_times_path);
+      if (static_cast<Eigen::Index>(stamps.size()) != trajectory.size()) {
+        throw InputError(options.kitti_times_path, 0, 0,
+                         fmt::format("has {} stamps but the KITTI poses file {} has {} poses; expected one stamp "
+                                     "per pose",
+                                     stamps.size(), path, trajectory.size()));
+      }
+      trajectory.SetStamps(std::move(stamps));
+    }
+  }
+  return trajectory;
+}
+
+Trajectory ReadTrajectory(const std::string& path, const ReadOptions& options, Format* format_read) {
+  return ParseTrajectory(ReadWholeFile(path), path, options, format_read);
+}
+
+std::vector<int64_t> ReadStampsFile(const std::string& path) {
+  const std::string content = ReadWholeFile(path);
+  LineScanner scanner(content);
+  std::vector<Field> fields;
+  std::vector<int64_t> stamps;
+  while (scanner.Next()) {
+    scanner.Split(' ', &fields);
+    if (fields.size() != 1) {
+      throw InputError(path, scanner.line_number(), fields.size() > 1 ? fields[1].column : 1,
+                       fmt::format("expected 1 field (t, seconds), got {}", fields.size()));
+    }
+    const StampParseResult r = ParseDecimalStamp(fields[0].text, 9);
+    if (r.error) {
+      throw InputError(path, scanner.line_number(), fields[0].column,
+                       fmt::format("expected a time stamp in seconds, got '{}'", fields[0].text));
+    }
+    stamps.push_back(r.value);
+  }
+  if (stamps.empty()) {
+    throw InputError(path, scanner.line_number() + 1, 1, "no stamps: expected one time stamp (seconds) per line");
+  }
+  return stamps;
+}
+
+}  // namespace cheval::traj

@@ -1,0 +1,125 @@
+// Trajectory writers and atomic file output.
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <random>
+
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+#include "cheval/common/error.h"
+#include "cheval/traj/io.h"
+#include "cheval/traj/stamp.h"
+
+namespace cheval::traj {
+namespace {
+
+// The orientation of pose i as (x, y, z, w): the stored values as read, or the matrix's.
+Eigen::Vector4d QuaternionAsStored(const TrajectoryView& trajectory, Eigen::Index i) {
+  if (trajectory.channels().orientation == OrientationKind::kQuaternion) return trajectory.quaternions().col(i);
+  return trajectory.UnitQuaternion(i).coeffs();
+}
+
+void RequireOrientation(const TrajectoryView& trajectory, Format format) {
+  if (!trajectory.has_orientation()) {
+    throw ComputeError(fmt::format("cannot write {}: the trajectory has no orientation (position only)",
+                                   ToString(format)));
+  }
+}
+
+}  // namespace
+
+std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
+  fmt::memory_buffer out;
+  auto it = std::back_inserter(out);
+  const auto p = trajectory.positions();
+  switch (format) {
+    case Format::kTum:
+    case Format::kTumV: {
+      RequireOrientation(trajectory, format);
+      if (format == Format::kTumV && !trajectory.has_velocity()) {
+        throw ComputeError("cannot write tumv: the trajectory has no velocity (use `cheval velocity` to add it)");
+      }
+      for (Eigen::Index i = 0; i < trajectory.size(); ++i) {
+        const Eigen::Vector4d q = QuaternionAsStored(trajectory, i);
+        fmt::format_to(it, "{} {} {} {} {} {} {} {}", FormatSeconds(trajectory.stamps_ns()[i]), p(0, i), p(1, i),
+                       p(2, i), q[0], q[1], q[2], q[3]);
+        if (format == Format::kTumV) {
+          const auto v = trajectory.velocities().col(i);
+          fmt::format_to(it, " {} {} {}", v[0], v[1], v[2]);
+        }
+        out.push_back('\n');
+      }
+      break;
+    }
+    case Format::kEuroc: {
+      RequireOrientation(trajectory, format);
+      fmt::format_to(it, "#timestamp [ns],p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],"
+                         "q_RS_z []");
+      if (trajectory.has_velocity()) {
+        fmt::format_to(it, ",v_RS_R_x [m s^-1],v_RS_R_y [m s^-1],v_RS_R_z [m s^-1]");
+      }
+      out.push_back('\n');
+      for (Eigen::Index i = 0; i < trajectory.size(); ++i) {
+        const Eigen::Vector4d q = QuaternionAsStored(trajectory, i);
+        fmt::format_to(it, "{},{},{},{},{},{},{},{}", trajectory.stamps_ns()[i], p(0, i), p(1, i), p(2, i), q[3],
+                       q[0], q[1], q[2]);
+        if (trajectory.has_velocity()) {
+          const auto v = trajectory.velocities().col(i);
+          fmt::format_to(it, ",{},{},{}", v[0], v[1], v[2]);
+        }
+        out.push_back('\n');
+      }
+      break;
+    }
+    case Format::kKitti: {
+      RequireOrientation(trajectory, format);
+      for (Eigen::Index i = 0; i < trajectory.size(); ++i) {
+        const Eigen::Matrix3d R = trajectory.Rotation(i);
+        fmt::format_to(it, "{} {} {} {} {} {} {} {} {} {} {} {}\n", R(0, 0), R(0, 1), R(0, 2), p(0, i), R(1, 0),
+                       R(1, 1), R(1, 2), p(1, i), R(2, 0), R(2, 1), R(2, 2), p(2, i));
+      }
+      break;
+    }
+    default:
+      throw UsageError(fmt::format("cannot write format '{}'; expected tum, tumv, euroc or kitti", ToString(format)));
+  }
+  return fmt::to_string(out);
+}
+
+void WriteFileAtomically(const std::string& path, std::string_view text) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path directory = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::random_device entropy;
+  const fs::path temporary =
+      directory / fmt::format(".{}.tmp-{}-{:x}", target.filename().string(), ::getpid(), entropy());
+  std::FILE* file = std::fopen(temporary.c_str(), "wbx");
+  if (file == nullptr) {
+    throw OutputError(fmt::format("{}: error: cannot write: {}", path, std::strerror(errno)));
+  }
+  const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size();
+  const bool flushed = std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
+  const int saved_errno = errno;
+  const bool closed = std::fclose(file) == 0;
+  if (!written || !flushed || !closed) {
+    std::error_code ignored;
+    fs::remove(temporary, ignored);
+    throw OutputError(fmt::format("{}: error: cannot write: {}", path, std::strerror(saved_errno)));
+  }
+  std::error_code error;
+  fs::rename(temporary, target, error);
+  if (error) {
+    std::error_code ignored;
+    fs::remove(temporary, ignored);
+    throw OutputError(fmt::format("{}: error: cannot write: {}", path, error.message()));
+  }
+}
+
+void WriteTrajectory(const std::string& path, const TrajectoryView& trajectory, Format format) {
+  WriteFileAtomically(path, FormatTrajectory(trajectory, format));
+}
+
+}  // namespace cheval::traj

@@ -1,0 +1,117 @@
+// `cheval info FILE...`: what is in a trajectory file, like `evo_traj --full_check`.
+#include <cstdio>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "cheval/traj/stamp.h"
+#include "cheval/traj/summary.h"
+#include "common.h"
+
+namespace cheval::cli {
+namespace {
+
+struct InfoFlags {
+  std::vector<std::string> paths;
+  InputFlags input;
+  std::string json_path;
+};
+
+nlohmann::json StatsJson(const traj::BasicStats& s) {
+  return {{"mean", s.mean}, {"median", s.median}, {"min", s.min}, {"max", s.max}, {"std", s.std}, {"n", s.n}};
+}
+
+nlohmann::json SummaryJson(const std::string& path, traj::Format format, const traj::TrajectorySummary& s) {
+  nlohmann::json j;
+  j["path"] = path;
+  j["format"] = std::string(traj::ToString(format));
+  j["poses"] = s.poses;
+  j["has_stamps"] = s.has_stamps;
+  j["first_stamp_s"] = traj::FormatSeconds(s.first_stamp_ns);
+  j["last_stamp_s"] = traj::FormatSeconds(s.last_stamp_ns);
+  j["duration_s"] = s.duration_s;
+  j["rate_hz"] = s.rate_hz;
+  j["dt_s"] = StatsJson(s.dt_s);
+  j["gaps"] = s.gaps;
+  j["largest_gap_s"] = s.largest_gap_s;
+  j["path_length_m"] = s.path_length_m;
+  j["speed_mps"] = StatsJson(s.speed_mps);
+  j["speed_source"] = s.speed_from_velocity ? "velocity" : "finite_differences";
+  j["has_orientation"] = s.has_orientation;
+  j["has_velocity"] = s.has_velocity;
+  j["has_angular_velocity"] = s.has_angular_velocity;
+  j["duplicate_stamps"] = s.duplicate_stamps;
+  j["non_increasing_stamps"] = s.non_increasing_stamps;
+  j["non_unit_quaternions"] = s.non_unit_quaternions;
+  j["max_quaternion_norm_error"] = s.max_quaternion_norm_error;
+  j["max_orthonormality_error"] = s.max_orthonormality_error;
+  return j;
+}
+
+void PrintSummary(const std::string& path, traj::Format format, const traj::TrajectorySummary& s) {
+  auto line = [](std::string_view key, const std::string& value) { fmt::print("  {:<22}{}\n", key, value); };
+  fmt::print("{} ({})\n", path, traj::ToString(format));
+  line("poses", fmt::format("{}", s.poses));
+  if (s.has_stamps) {
+    line("duration", fmt::format("{:.6f} s  ({} .. {})", s.duration_s, traj::FormatSeconds(s.first_stamp_ns),
+                                 traj::FormatSeconds(s.last_stamp_ns)));
+    line("rate", fmt::format("{:.3f} Hz mean; dt median {:.3f} ms, jitter (std) {:.3f} ms, min {:.3f} ms, max {:.3f} ms",
+                             s.rate_hz, 1e3 * s.dt_s.median, 1e3 * s.dt_s.std, 1e3 * s.dt_s.min, 1e3 * s.dt_s.max));
+    line("gaps (> 2x median dt)", s.gaps == 0 ? std::string("none")
+                                              : fmt::format("{}, largest {:.3f} s after {}", s.gaps, s.largest_gap_s,
+                                                            traj::FormatSeconds(s.largest_gap_after_ns)));
+    line("stamps", s.non_increasing_stamps == 0 && s.duplicate_stamps == 0
+                       ? std::string("strictly increasing")
+                       : fmt::format("NOT strictly increasing: {} duplicate, {} non-increasing (kept in file order)",
+                                     s.duplicate_stamps, s.non_increasing_stamps));
+  } else {
+    line("stamps", "none (KITTI without --kitti-times)");
+  }
+  line("path length", fmt::format("{:.3f} m", s.path_length_m));
+  if (s.speed_mps.n > 0) {
+    line(s.speed_from_velocity ? "speed (velocity cols)" : "speed (finite diff.)",
+         fmt::format("mean {:.3f}, median {:.3f}, max {:.3f} m/s", s.speed_mps.mean, s.speed_mps.median,
+                     s.speed_mps.max));
+  }
+  if (!s.has_orientation) {
+    line("orientation", "none (position only)");
+  } else if (s.max_orthonormality_error > 0) {
+    line("orientation", fmt::format("rotation matrices, max |RᵀR - I| {:.2e} (used as read)",
+                                    s.max_orthonormality_error));
+  } else {
+    line("orientation", fmt::format("quaternions, {} non-unit (|‖q‖-1| > {:g}; max {:.2e}), normalised on use",
+                                    s.non_unit_quaternions, traj::kQuaternionNormTolerance,
+                                    s.max_quaternion_norm_error));
+  }
+  line("velocity", s.has_velocity ? "yes (world frame)" : "no");
+  line("angular velocity", s.has_angular_velocity ? "yes (body frame)" : "no");
+}
+
+}  // namespace
+
+void RegisterInfo(CLI::App& app, Action* action) {
+  auto flags = std::make_shared<InfoFlags>();
+  CLI::App* command = app.add_subcommand("info", "Summarise trajectory files: poses, duration, rate, gaps, stamps, "
+                                                 "path length, speed, quaternion norms");
+  command->add_option("files", flags->paths, "Trajectory files")->required();
+  AddInputFlags(command, &flags->input);
+  command->add_option("--json", flags->json_path, "Also write the summary as JSON (an array for several files)");
+  command->callback([flags, action] {
+    *action = [flags] {
+      const traj::ReadOptions options = flags->input.ToReadOptions();
+      nlohmann::json all = nlohmann::json::array();
+      for (const std::string& path : flags->paths) {
+        traj::Format format = options.format;
+        const traj::Trajectory trajectory = traj::ReadTrajectory(path, options, &format);
+        const traj::TrajectorySummary summary = traj::Summarize(trajectory.View());
+        PrintSummary(path, format, summary);
+        all.push_back(SummaryJson(path, format, summary));
+      }
+      if (!flags->json_path.empty()) {
+        traj::WriteFileAtomically(flags->json_path, (all.size() == 1 ? all[0] : all).dump(2) + "\n");
+      }
+    };
+  });
+}
+
+}  // namespace cheval::cli
