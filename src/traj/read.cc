@@ -277,7 +277,7 @@ class Reader {
         layout.field_counts = {count};
       } else {
         Fail(scanner_.end_column(),
-             fmt::format("expected 8 fields (t_ns px py pz qw qx qy qz) or at least 11 (… vx vy vz), got {}", count));
+             fmt::format("expected 8 fields (t_ns px py pz qw qx qy qz) or at least 11 (... vx vy vz), got {}", count));
       }
     } else if (layout.format == Format::kVins && layout.field_counts.empty()) {
       if (count == 8 || count == 11) {
@@ -285,7 +285,7 @@ class Reader {
         layout.field_counts = {count};
       } else {
         Fail(scanner_.end_column(),
-             fmt::format("expected 8 fields (t_ns px py pz qw qx qy qz) or 11 (… vx vy vz), got {}", count));
+             fmt::format("expected 8 fields (t_ns px py pz qw qx qy qz) or 11 (... vx vy vz), got {}", count));
       }
     }
     return layout;
@@ -463,11 +463,12 @@ Format DetectFormat(const std::string& path, std::string_view content) {
     std::string comment(scanner.first_comment());
     std::transform(comment.begin(), comment.end(), comment.begin(), [](unsigned char c) { return std::tolower(c); });
     if (separator == ',') {
-      if (comment.rfind("#timestamp", 0) == 0 || comment.find("p_rs_r") != std::string::npos) return Format::kEuroc;
+      // EuRoC: a '#' header naming the time column first (`#timestamp`, `#time(ns)`) or EuRoC's p_RS_R.
+      if (comment.rfind("#time", 0) == 0 || comment.find("p_rs_r") != std::string::npos) return Format::kEuroc;
       if (!header && IsIntegerNanoseconds(fields[0].text) && (count == 8 || count == 11)) return Format::kVins;
       throw InputError(path, scanner.line_number(), 1,
                        fmt::format("cannot detect the format: {} comma-separated fields{}; EuRoC needs a "
-                                   "'#timestamp' header, VINS integer nanosecond stamps and 8 or 11 fields. "
+                                   "'#timestamp' or '#time' header, VINS integer nanosecond stamps and 8 or 11 fields. "
                                    "Use --format csv --columns ... (e.g. t_ns,px,py,pz,qw,qx,qy,qz)",
                                    count, header ? " after a header row" : ""));
     }

@@ -1,0 +1,164 @@
+// The `cheval` executable end to end: exit codes, the one-line error on stderr, JSON keys, and no
+// output file left behind when a command fails.
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "../support/test_data.h"
+
+namespace cheval {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string Slurp(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("cheval_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+            std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Runs `cheval ARGS` through the shell with stdout and stderr captured in files.
+  RunResult Cheval(const std::string& args) const {
+    const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
+    const std::string command = std::string(CHEVAL_EXE) + " " + args + " >" + out.string() + " 2>" + err.string();
+    const int status = std::system(command.c_str());
+    RunResult run;
+    run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    run.out = Slurp(out);
+    run.err = Slurp(err);
+    return run;
+  }
+
+  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+
+  fs::path dir_;
+};
+
+TEST_F(CliTest, SimInfoConvertPipeline) {
+  RunResult sim = Cheval("sim motion --kind drone --seed 3 --noise 0.001 --duration 10 --rate 100 -o " + Path("m.txt") +
+                   " --truth " + Path("truth.txt"));
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+
+  RunResult info = Cheval("info " + Path("truth.txt") + " --json " + Path("info.json"));
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_NE(info.out.find("(tumv)"), std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(Slurp(Path("info.json")));
+  for (const char* key : {"poses", "duration_s", "rate_hz", "path_length_m", "has_velocity", "has_orientation",
+                          "duplicate_stamps", "non_increasing_stamps"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_EQ(j["poses"], 1001);
+  EXPECT_DOUBLE_EQ(j["duration_s"].get<double>(), 10.0);
+  EXPECT_NEAR(j["rate_hz"].get<double>(), 100.0, 1e-9);
+  EXPECT_EQ(j["has_velocity"], true);
+  EXPECT_EQ(j["duplicate_stamps"], 0);
+
+  RunResult convert = Cheval("convert " + Path("truth.txt") + " -o " + Path("truth.csv"));
+  ASSERT_EQ(convert.exit_code, 0) << convert.err;
+  EXPECT_EQ(Slurp(Path("truth.csv")).rfind("#timestamp [ns]", 0), 0u);  // .csv -> EuRoC by default
+  RunResult back = Cheval("convert " + Path("truth.csv") + " --to tumv -o " + Path("back.txt"));
+  ASSERT_EQ(back.exit_code, 0) << back.err;
+  EXPECT_EQ(Slurp(Path("back.txt")), Slurp(Path("truth.txt")));  // TUM -> EuRoC -> TUM is lossless
+
+  RunResult kitti = Cheval("convert " + Path("m.txt") + " --to kitti -o " + Path("m.kitti") + " --times-output " +
+                     Path("times.txt"));
+  ASSERT_EQ(kitti.exit_code, 0) << kitti.err;
+  RunResult kitti_info = Cheval("info " + Path("m.kitti") + " --kitti-times " + Path("times.txt") + " --json " +
+                          Path("k.json"));
+  ASSERT_EQ(kitti_info.exit_code, 0) << kitti_info.err;
+  EXPECT_EQ(nlohmann::json::parse(Slurp(Path("k.json")))["poses"], 1001);
+}
+
+TEST_F(CliTest, BadInputIsOneLineAndExitCode2) {
+  const std::string bad = cheval::testing::FixturePath("bad/not_a_number.txt");
+  RunResult run = Cheval("info " + bad);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_EQ(run.err, bad + ":2:7: error: expected a number for field 3 (y), got 'abc'\n");
+  RunResult missing = Cheval("info " + Path("nope.txt"));
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_EQ(missing.err, Path("nope.txt") + ":0:0: error: cannot open file: No such file or directory\n");
+}
+
+TEST_F(CliTest, FailedConvertLeavesNoFile) {
+  RunResult run = Cheval("convert " + cheval::testing::FixturePath("bad/truncated_last_line.txt") + " -o " + Path("out.txt"));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_FALSE(fs::exists(Path("out.txt")));
+  // Asking for velocity the input does not have: exit 3, nothing written.
+  std::ofstream(Path("pose.txt")) << "1 0 0 0 0 0 0 1\n";
+  RunResult no_velocity = Cheval("convert " + Path("pose.txt") + " --to tumv -o " + Path("v.txt"));
+  EXPECT_EQ(no_velocity.exit_code, 3);
+  EXPECT_EQ(no_velocity.err, "cheval: error: cannot write tumv: the trajectory has no velocity (use `cheval velocity` "
+                             "to add it)\n");
+  EXPECT_FALSE(fs::exists(Path("v.txt")));
+  // An unwritable destination: exit 4 and no temporary file left in the folder.
+  RunResult unwritable = Cheval("convert " + Path("pose.txt") + " -o " + Path("no/such/dir/out.txt"));
+  EXPECT_EQ(unwritable.exit_code, 4);
+  EXPECT_NE(unwritable.err.find("no/such/dir/out.txt: error: cannot write"), std::string::npos);
+  // A failed run does not clobber an existing output either.
+  std::ofstream(Path("keep.txt")) << "precious\n";
+  RunResult clobber = Cheval("convert " + cheval::testing::FixturePath("bad/nan.txt") + " -o " + Path("keep.txt"));
+  EXPECT_EQ(clobber.exit_code, 2);
+  EXPECT_EQ(Slurp(Path("keep.txt")), "precious\n");
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir_)) ++entries;
+  EXPECT_EQ(entries, 4u);  // stdout, stderr, pose.txt, keep.txt
+}
+
+TEST_F(CliTest, UsageErrorsExitWith1) {
+  EXPECT_EQ(Cheval("info").exit_code, 1);
+  EXPECT_EQ(Cheval("info x.txt --no-such-flag").exit_code, 1);
+  EXPECT_EQ(Cheval("info x.txt --format bogus").exit_code, 1);
+  EXPECT_EQ(Cheval("frobnicate").exit_code, 1);
+  RunResult columns = Cheval("info " + cheval::testing::FixturePath("bad/nan.txt") + " --columns t,px,py");
+  EXPECT_EQ(columns.exit_code, 1);
+  EXPECT_EQ(columns.err, "cheval: error: --columns: expected all three position columns px, py, pz\n");
+  RunResult csv = Cheval("info " + cheval::testing::FixturePath("bad/nan.txt") + " --format csv");
+  EXPECT_EQ(csv.exit_code, 1);
+  EXPECT_EQ(Cheval("sim motion --duration -1 -o " + Path("x.txt")).exit_code, 1);
+  EXPECT_FALSE(fs::exists(Path("x.txt")));
+  EXPECT_EQ(Cheval("--help").exit_code, 0);
+}
+
+TEST_F(CliTest, InfoReadsSharedDataWithStatedCounts) {
+  CHEVAL_REQUIRE_SHARED_DATA();
+  const std::string root = cheval::testing::SharedDataDir();
+  RunResult run = Cheval("info " + root + "/evo/fr2_desk_groundtruth.txt " + root + "/evo/V102_groundtruth.csv --json " +
+                   Path("all.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json all = nlohmann::json::parse(Slurp(Path("all.json")));
+  ASSERT_TRUE(all.is_array());
+  EXPECT_EQ(all[0]["poses"], 20957);     // evo/SOURCE.md
+  EXPECT_EQ(all[0]["duplicate_stamps"], 1);  // stamp 1311868229.5760 appears twice (lines 10862-10863)
+  EXPECT_EQ(all[1]["poses"], 16702);
+  EXPECT_EQ(all[1]["has_velocity"], true);
+  // Last minus first stamp, 1403715608412143104 - 1403715524907143168 ns (SOURCE.md rounds to 83.50 s).
+  EXPECT_DOUBLE_EQ(all[1]["duration_s"].get<double>(), 83.504999936);
+}
+
+}  // namespace
+}  // namespace cheval
