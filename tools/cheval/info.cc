@@ -53,8 +53,8 @@ void PrintSummary(const std::string& path, traj::Format format, const traj::Traj
   fmt::print("{} ({})\n", path, traj::ToString(format));
   line("poses", fmt::format("{}", s.poses));
   if (s.has_stamps) {
-    line("duration", fmt::format("{:.6f} s  ({} .. {})", s.duration_s, traj::FormatSeconds(s.first_stamp_ns),
-                                 traj::FormatSeconds(s.last_stamp_ns)));
+    line("duration", fmt::format("{} s  ({} .. {})", traj::FormatSeconds(s.last_stamp_ns - s.first_stamp_ns),
+                                 traj::FormatSeconds(s.first_stamp_ns), traj::FormatSeconds(s.last_stamp_ns)));
     line("rate", fmt::format("{:.3f} Hz mean; dt median {:.3f} ms, jitter (std) {:.3f} ms, min {:.3f} ms, max {:.3f} ms",
                              s.rate_hz, 1e3 * s.dt_s.median, 1e3 * s.dt_s.std, 1e3 * s.dt_s.min, 1e3 * s.dt_s.max));
     line("gaps (> 2x median dt)", s.gaps == 0 ? std::string("none")
