@@ -1,0 +1,155 @@
+#include "cheval/cheb/fit.h"
+
+#include <algorithm>
+#include <array>
+
+#include <Eigen/Cholesky>
+#include <fmt/format.h>
+
+#include "cheval/common/error.h"
+
+namespace cheval::cheb {
+
+Eigen::RowVectorXd ChebyshevSeries::Value(double t) const { return Clenshaw(coefficients, interval.ToUnit(t)); }
+
+Eigen::RowVectorXd ChebyshevSeries::Derivative(double t) const {
+  return Clenshaw(DerivativeCoefficients(coefficients), interval.ToUnit(t)) * interval.DerivativeScale();
+}
+
+Eigen::MatrixXd ChebyshevSeries::ValuesAtPoints() const { return CoefficientsToValues(coefficients); }
+
+namespace {
+
+// Samples are processed in chunks small enough for L1 (x, T_{n-1}, T_n, ω, ω·z of each sample),
+// looping over n inside a chunk; sums run in kLanes independent accumulators so the compiler can
+// vectorise without reassociating floating point. Only n = 0..N is iterated: with
+// T_{2n} = 2T_n² - 1 and T_{2n+1} = 2T_n T_{n+1} - x, the upper moments are
+// S_{2n} = 2Σω T_n² - S_0 and S_{2n+1} = 2Σω T_n T_{n+1} - S_1.
+constexpr int kLanes = 8;
+constexpr int kChunk = 512;  // a multiple of kLanes
+
+struct Moments {
+  std::vector<double> s;         // S_n, n = 0..2N
+  std::vector<double> squares;   // Σω T_n², n = 0..N
+  std::vector<double> products;  // Σω T_n T_{n+1}, n = 0..N
+  Eigen::MatrixXd b;             // Σω T_n z, (N + 1) x d
+};
+
+// Built twice where the compiler supports function multi-versioning: for x86-64-v3 (AVX2 + FMA)
+// and the baseline; the loader picks the one the CPU runs.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+#define CHEVAL_MULTIVERSION __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define CHEVAL_MULTIVERSION
+#endif
+
+// Adds one chunk's contribution. Arrays have kChunk entries (padding has ω = 0); wz is d x kChunk.
+template <int D>
+CHEVAL_MULTIVERSION void AccumulateChunk(const double* x, const double* w, const double* wz, int degree,
+                                         Moments* moments) {
+  alignas(64) double t_prev[kChunk], t_cur[kChunk], two_x[kChunk];
+  for (int k = 0; k < kChunk; ++k) {
+    t_prev[k] = 1.0;
+    t_cur[k] = x[k];
+    two_x[k] = 2.0 * x[k];
+  }
+  for (int n = 0; n <= degree; ++n) {
+    // Here t_prev = T_n and t_cur = T_{n+1}.
+    double acc_s[kLanes] = {}, acc_sq[kLanes] = {}, acc_prod[kLanes] = {}, acc_b[D][kLanes] = {};
+    for (int k = 0; k < kChunk; k += kLanes) {
+      for (int l = 0; l < kLanes; ++l) {
+        const double tn = t_prev[k + l], tn1 = t_cur[k + l], wk = w[k + l];
+        const double wtn = wk * tn;
+        acc_s[l] += wtn;
+        acc_sq[l] += wtn * tn;
+        acc_prod[l] += wtn * tn1;
+        for (int c = 0; c < D; ++c) acc_b[c][l] += wz[c * kChunk + k + l] * tn;
+        t_prev[k + l] = tn1;
+        t_cur[k + l] = two_x[k + l] * tn1 - tn;
+      }
+    }
+    double s = 0, sq = 0, prod = 0;
+    for (int l = 0; l < kLanes; ++l) s += acc_s[l], sq += acc_sq[l], prod += acc_prod[l];
+    moments->s[n] += s;
+    moments->squares[n] += sq;
+    moments->products[n] += prod;
+    for (int c = 0; c < D; ++c) {
+      double bc = 0;
+      for (int l = 0; l < kLanes; ++l) bc += acc_b[c][l];
+      moments->b(n, c) += bc;
+    }
+  }
+}
+
+template <int D>
+void AccumulateAll(const Eigen::VectorXd& x, const Eigen::VectorXd& w, const Eigen::Ref<const Eigen::MatrixXd>& z,
+                   int degree, Moments* moments) {
+  alignas(64) double cx[kChunk], cw[kChunk], cwz[D * kChunk];
+  const Eigen::Index m = x.size();
+  for (Eigen::Index begin = 0; begin < m; begin += kChunk) {
+    const int count = static_cast<int>(std::min<Eigen::Index>(kChunk, m - begin));
+    for (int k = 0; k < kChunk; ++k) {
+      const bool live = k < count;
+      cx[k] = live ? x[begin + k] : 0.0;
+      cw[k] = live ? w[begin + k] : 0.0;
+      for (int c = 0; c < D; ++c) cwz[c * kChunk + k] = live ? w[begin + k] * z(begin + k, c) : 0.0;
+    }
+    AccumulateChunk<D>(cx, cw, cwz, degree, moments);
+  }
+}
+
+}  // namespace
+
+ChebyshevSeries FitLeastSquares(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
+                                int degree, const Interval& interval, const Eigen::VectorXd* weights) {
+  const Eigen::Index m = t.size();
+  const int d = static_cast<int>(z.cols());
+  if (z.rows() != m) throw std::invalid_argument("FitLeastSquares: t and z have different lengths");
+  if (d < 1 || d > 4) throw std::invalid_argument("FitLeastSquares: dimension must be 1..4");
+  if (degree < 0) throw std::invalid_argument("FitLeastSquares: negative degree");
+  if (weights != nullptr && weights->size() != m) throw std::invalid_argument("FitLeastSquares: weights length");
+  if (m < degree + 1) {
+    throw ComputeError(fmt::format("a degree-{} fit needs at least {} samples, got {}", degree, degree + 1, m));
+  }
+  Eigen::VectorXd x(m);
+  for (Eigen::Index i = 0; i < m; ++i) x[i] = interval.ToUnit(t[i]);
+  const Eigen::VectorXd w = weights != nullptr ? *weights : Eigen::VectorXd::Ones(m);
+  Moments moments;
+  moments.s.assign(2 * degree + 2, 0.0);
+  moments.squares.assign(degree + 1, 0.0);
+  moments.products.assign(degree + 1, 0.0);
+  moments.b = Eigen::MatrixXd::Zero(degree + 1, d);
+  switch (d) {
+    case 1: AccumulateAll<1>(x, w, z, degree, &moments); break;
+    case 2: AccumulateAll<2>(x, w, z, degree, &moments); break;
+    case 3: AccumulateAll<3>(x, w, z, degree, &moments); break;
+    case 4: AccumulateAll<4>(x, w, z, degree, &moments); break;
+    default: throw std::invalid_argument("FitLeastSquares: dimension must be 1..4");
+  }
+  Eigen::VectorXd s(2 * degree + 1);
+  for (int n = 0; n <= degree; ++n) s[n] = moments.s[n];
+  const double s0 = moments.s[0], s1 = degree >= 1 ? moments.s[1] : 0.0;
+  for (int n = 1; 2 * n <= 2 * degree; ++n) {
+    if (2 * n > degree) s[2 * n] = 2.0 * moments.squares[n] - s0;
+    if (2 * n + 1 > degree && 2 * n + 1 <= 2 * degree) s[2 * n + 1] = 2.0 * moments.products[n] - s1;
+  }
+  const Eigen::MatrixXd& b = moments.b;
+  Eigen::MatrixXd gram(degree + 1, degree + 1);
+  for (int i = 0; i <= degree; ++i) {
+    for (int j = 0; j <= degree; ++j) gram(i, j) = 0.5 * (s[i + j] + s[std::abs(i - j)]);
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(gram);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive() ||
+      ldlt.vectorD().minCoeff() <= 1e-13 * ldlt.vectorD().maxCoeff()) {
+    throw ComputeError(fmt::format(
+        "the degree-{} least-squares fit is singular: {} samples do not determine the polynomial "
+        "(too few distinct stamps?)",
+        degree, m));
+  }
+  ChebyshevSeries series;
+  series.interval = interval;
+  series.coefficients = ldlt.solve(b);
+  return series;
+}
+
+}  // namespace cheval::cheb
