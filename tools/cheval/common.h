@@ -30,5 +30,6 @@ using Action = std::function<void()>;
 void RegisterInfo(CLI::App& app, Action* action);
 void RegisterConvert(CLI::App& app, Action* action);
 void RegisterSim(CLI::App& app, Action* action);
+void RegisterVelocity(CLI::App& app, Action* action);
 
 }  // namespace cheval::cli

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   cheval::cli::RegisterInfo(app, &action);
   cheval::cli::RegisterConvert(app, &action);
   cheval::cli::RegisterSim(app, &action);
+  cheval::cli::RegisterVelocity(app, &action);
 
   auto fail = [](ExitCode code, const std::string& message) {
     std::fprintf(stderr, "%s\n", message.c_str());

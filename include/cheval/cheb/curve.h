@@ -1,0 +1,107 @@
+#pragma once
+/// \file
+/// A continuous-time curve fitted to stamped samples: overlapping windowed Chebyshev least-squares
+/// fits with automatically chosen degrees, blended smoothly, split at gaps. Gives position,
+/// velocity and acceleration at any time inside the data (the C-ASE ground-truth velocity).
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "cheval/cheb/fit.h"
+
+namespace cheval::cheb {
+
+/// How the degree of each window is chosen.
+enum class DegreeMethod {
+  kChop,             ///< standardChop on a high-degree fit, tolerance from the estimated noise (default)
+  kCrossValidation,  ///< 5-fold cross-validation over a grid of degrees
+  kFixed,            ///< the given degree in every window
+};
+
+/// Options of FitCurve; defaults need no tuning.
+struct CurveOptions {
+  DegreeMethod degree_method = DegreeMethod::kChop;
+  /// kFixed: the degree. With a single window this is the classic global fit.
+  int fixed_degree = 0;
+  /// Fixed window length (s); nullopt = adaptive: windows are halved until their series resolve.
+  std::optional<double> window_s;
+  /// Upper bound of N²/m in a window: beyond it equispaced least squares is ill-conditioned
+  /// (CHEBYSHEV.md: N²/m = 8 -> condition ~15, 32 -> 2e5).
+  double max_conditioning = 8.0;
+  /// Largest degree tried in a window.
+  int max_degree = 400;
+  /// Windows are not split below this many samples.
+  int min_window_samples = 24;
+  /// Each window extends beyond its core by this fraction of the core on both sides.
+  double overlap = 0.25;
+  /// A stamp difference larger than both gap_factor x the median difference and min_gap_s splits
+  /// the data into segments that are fitted separately (no polynomial bridges a long gap). A lone
+  /// sample between two gaps joins the neighbour across the shorter gap.
+  double gap_factor = 4.0;
+  double min_gap_s = 0.1;
+  /// Noise standard deviation of the samples (same unit as them); nullopt = estimated from the data.
+  std::optional<double> noise_sigma;
+  /// Fit a single window over each gap-free segment (no splitting), e.g. to reproduce a global fit.
+  bool single_window = false;
+};
+
+/// One window: its core [core_begin, core_end] (seconds from the curve's origin), the samples used
+/// and the fit, with a degree per coordinate (coefficients of lower-degree coordinates are padded
+/// with zeros).
+struct CurveWindow {
+  double core_begin = 0, core_end = 0;
+  double fit_begin = 0, fit_end = 0;
+  Eigen::Index samples = 0;
+  std::vector<int> degrees;
+  ChebyshevSeries series;
+  /// Coefficients of d/dx and d²/dx² of `series` (x the window's unit variable).
+  Eigen::MatrixXd first_derivative, second_derivative;
+  /// |c_k| per coordinate of the high-degree fit the degree was chosen from (diagnostics), (K x d).
+  Eigen::MatrixXd coefficient_magnitudes;
+};
+
+/// A gap-free stretch of data with its windows, ordered in time.
+struct CurveSegment {
+  double begin = 0, end = 0;  ///< first and last sample time (s from origin)
+  std::vector<CurveWindow> windows;
+};
+
+/// The fitted curve.
+class Curve {
+ public:
+  /// Value, first and second derivative (per second) at `stamp_ns`. Throws ComputeError when the
+  /// time lies outside every segment by more than `tolerance_s` (e.g. inside a gap).
+  void Evaluate(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value, Eigen::Ref<Eigen::VectorXd> derivative,
+                Eigen::Ref<Eigen::VectorXd> second_derivative, double tolerance_s = 0.0) const;
+
+  int64_t origin_ns() const { return origin_ns_; }
+  int dimension() const { return dimension_; }
+  const std::vector<CurveSegment>& segments() const { return segments_; }
+  /// The noise σ per coordinate used to choose degrees (estimated or given).
+  const Eigen::VectorXd& noise_sigma() const { return noise_sigma_; }
+  /// Root mean square of the fit residuals over all samples (per coordinate).
+  const Eigen::VectorXd& residual_rms() const { return residual_rms_; }
+  /// Total number of stored values (Σ over windows of (degree + 1) per coordinate).
+  Eigen::Index stored_values() const;
+
+ private:
+  friend Curve FitCurve(std::span<const int64_t>, const Eigen::Ref<const Eigen::MatrixXd>&, const CurveOptions&);
+  int64_t origin_ns_ = 0;
+  int dimension_ = 0;
+  std::vector<CurveSegment> segments_;
+  Eigen::VectorXd noise_sigma_;
+  Eigen::VectorXd residual_rms_;
+};
+
+/// Fits `values` (m x d, d <= 4; row i sampled at stamps_ns[i]) with a Curve. Stamps need not be
+/// sorted or unique (samples are sorted by stamp; equal stamps are averaged by the least squares).
+/// Throws ComputeError for fewer than 2 samples, all-equal stamps, or a fixed degree above what a
+/// window's samples support; UsageError for bad options.
+Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen::MatrixXd>& values,
+               const CurveOptions& options = {});
+
+}  // namespace cheval::cheb

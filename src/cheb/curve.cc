@@ -1,0 +1,346 @@
+#include "cheval/cheb/curve.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include <fmt/format.h>
+
+#include "cheval/cheb/degree.h"
+#include "cheval/common/error.h"
+
+namespace cheval::cheb {
+namespace {
+
+// The relative tolerance below which coefficients are rounding, not signal: the chop's floor when
+// the data are noise-free.
+constexpr double kRoundingTolerance = 1e-13;
+
+void ValidateOptions(const CurveOptions& o) {
+  if (o.degree_method == DegreeMethod::kFixed && o.fixed_degree < 0) {
+    throw UsageError(fmt::format("--degree must be a non-negative integer, got {}", o.fixed_degree));
+  }
+  if (o.window_s && !(*o.window_s > 0.0 && std::isfinite(*o.window_s))) {
+    throw UsageError(fmt::format("--window must be a positive number of seconds, got {}", *o.window_s));
+  }
+  if (!(o.max_conditioning > 0.0)) throw UsageError("max_conditioning must be positive");
+  if (o.max_degree < 1) throw UsageError("max_degree must be at least 1");
+  if (!(o.overlap >= 0.0 && o.overlap <= 1.0)) throw UsageError("overlap must be in [0, 1]");
+  if (!(o.gap_factor > 1.0)) throw UsageError("gap_factor must be greater than 1");
+  if (!(o.min_gap_s >= 0.0)) throw UsageError("min_gap_s must be non-negative");
+  if (o.noise_sigma && !(*o.noise_sigma >= 0.0 && std::isfinite(*o.noise_sigma))) {
+    throw UsageError(fmt::format("--noise must be a non-negative number, got {}", *o.noise_sigma));
+  }
+  if (o.min_window_samples < 2) throw UsageError("min_window_samples must be at least 2");
+}
+
+// Fits one window and, for automatic degrees, says whether it should be split instead.
+class WindowFitter {
+ public:
+  WindowFitter(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Eigen::VectorXd& sigma,
+               const CurveOptions& options)
+      : t_(t), z_(z), sigma_(sigma), options_(options) {}
+
+  // Fits the window of core [a, b] inside segment [segment_begin, segment_end]. Returns nullopt
+  // when the series is not resolved and splitting is allowed.
+  std::optional<CurveWindow> Fit(double a, double b, double segment_begin, double segment_end, bool may_split) const {
+    const double extension = options_.overlap * (b - a);
+    CurveWindow window;
+    window.core_begin = a;
+    window.core_end = b;
+    window.fit_begin = std::max(a - extension, segment_begin);
+    window.fit_end = std::min(b + extension, segment_end);
+    const auto first = std::lower_bound(t_.data(), t_.data() + t_.size(), window.fit_begin) - t_.data();
+    const auto last = std::upper_bound(t_.data(), t_.data() + t_.size(), window.fit_end) - t_.data();
+    const Eigen::Index m = last - first;
+    window.samples = m;
+    Eigen::Index distinct = m > 0 ? 1 : 0;
+    for (Eigen::Index i = first + 1; i < last; ++i) distinct += t_[i] != t_[i - 1] ? 1 : 0;
+    const Interval interval{window.fit_begin, window.fit_end};
+    if (distinct < 2 || !(interval.b > interval.a)) {
+      throw ComputeError(fmt::format("cannot fit a window at {:.6f} s..{:.6f} s: it has {} distinct stamps",
+                                     window.fit_begin, window.fit_end, distinct));
+    }
+    const auto tw = t_.segment(first, m);
+    const auto zw = z_.middleRows(first, m);
+    const int d = static_cast<int>(z_.cols());
+    window.degrees.assign(d, 0);
+
+    if (options_.degree_method == DegreeMethod::kFixed) {
+      if (options_.fixed_degree + 1 > distinct) {
+        throw ComputeError(fmt::format(
+            "degree {} needs at least {} distinct stamps per window, but the window {:.6f} s..{:.6f} s has {}; "
+            "use a smaller --degree or a longer --window",
+            options_.fixed_degree, options_.fixed_degree + 1, window.fit_begin, window.fit_end, distinct));
+      }
+      std::fill(window.degrees.begin(), window.degrees.end(), options_.fixed_degree);
+      window.series = FitLeastSquares(tw, zw, options_.fixed_degree, interval);
+      window.coefficient_magnitudes = window.series.coefficients.cwiseAbs();
+      Finish(&window);
+      return window;
+    }
+
+    const int top = static_cast<int>(std::min<double>(
+        {static_cast<double>(options_.max_degree), std::floor(std::sqrt(options_.max_conditioning * m)),
+         static_cast<double>(distinct - 1)}));
+    const ChebyshevSeries high = FitLeastSquares(tw, zw, top, interval);
+    window.coefficient_magnitudes = high.coefficients.cwiseAbs();
+    bool resolved = true;
+    if (options_.degree_method == DegreeMethod::kChop) {
+      for (int c = 0; c < d; ++c) {
+        const Eigen::VectorXd coefficients = high.coefficients.col(c);
+        const double scale = coefficients.cwiseAbs().maxCoeff();
+        if (scale == 0.0) continue;  // a constant zero coordinate: degree 0
+        const double noise = sigma_[c] * std::sqrt(2.0 / static_cast<double>(m));
+        const double tol = std::clamp(noise / scale, kRoundingTolerance, 0.5);
+        const int keep = StandardChop(coefficients, tol);
+        // StandardChop needs 17 coefficients; below that, or without a plateau, it keeps all.
+        if (keep == top + 1) resolved = false;
+        window.degrees[c] = keep - 1;
+      }
+    } else {
+      for (int c = 0; c < d; ++c) window.degrees[c] = CrossValidatedDegree(tw, zw.col(c), top, interval);
+      resolved = *std::max_element(window.degrees.begin(), window.degrees.end()) < top;
+    }
+    if (!resolved && may_split) return std::nullopt;
+
+    const int degree = *std::max_element(window.degrees.begin(), window.degrees.end());
+    window.series.interval = interval;
+    window.series.coefficients = Eigen::MatrixXd::Zero(degree + 1, d);
+    for (int c = 0; c < d; ++c) {
+      const ChebyshevSeries axis = FitLeastSquares(tw, zw.col(c), window.degrees[c], interval);
+      window.series.coefficients.col(c).head(window.degrees[c] + 1) = axis.coefficients.col(0);
+    }
+    Finish(&window);
+    return window;
+  }
+
+ private:
+  static void Finish(CurveWindow* window) {
+    window->first_derivative = DerivativeCoefficients(window->series.coefficients);
+    window->second_derivative = DerivativeCoefficients(window->first_derivative);
+  }
+
+  // 5-fold cross-validation (folds interleaved: sample i in fold i mod 5) over a geometric grid
+  // of degrees up to `top`; returns the degree of least held-out squared error.
+  static int CrossValidatedDegree(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::VectorXd>& z,
+                                  int top, const Interval& interval) {
+    constexpr int kFolds = 5;
+    std::vector<int> grid;
+    for (double g = 2; g < top; g *= 1.25) {
+      const int degree = static_cast<int>(std::lround(g));
+      if (grid.empty() || degree != grid.back()) grid.push_back(degree);
+    }
+    grid.push_back(top);
+    const Eigen::Index m = t.size();
+    int best = grid.front();
+    double best_error = std::numeric_limits<double>::infinity();
+    for (int degree : grid) {
+      double error = 0.0;
+      bool feasible = true;
+      for (int fold = 0; fold < kFolds && feasible; ++fold) {
+        std::vector<Eigen::Index> train;
+        for (Eigen::Index i = 0; i < m; ++i) {
+          if (i % kFolds != fold) train.push_back(i);
+        }
+        if (static_cast<Eigen::Index>(train.size()) < degree + 2) {
+          feasible = false;
+          break;
+        }
+        Eigen::VectorXd tt(train.size());
+        Eigen::MatrixXd zz(train.size(), 1);
+        for (size_t k = 0; k < train.size(); ++k) tt[k] = t[train[k]], zz(k, 0) = z[train[k]];
+        try {
+          const ChebyshevSeries fit = FitLeastSquares(tt, zz, degree, interval);
+          for (Eigen::Index i = fold; i < m; i += kFolds) {
+            const double r = fit.Value(t[i])[0] - z[i];
+            error += r * r;
+          }
+        } catch (const ComputeError&) {
+          feasible = false;
+        }
+      }
+      if (feasible && error < best_error) best_error = error, best = degree;
+    }
+    return best;
+  }
+
+  const Eigen::VectorXd& t_;
+  const Eigen::MatrixXd& z_;
+  const Eigen::VectorXd& sigma_;
+  const CurveOptions& options_;
+};
+
+// Quintic smoothstep s(u) = 6u⁵ - 15u⁴ + 10u³ and its first two derivatives in u: C² blending.
+void Smoothstep(double u, double* s, double* ds, double* dds) {
+  u = std::clamp(u, 0.0, 1.0);
+  *s = u * u * u * (u * (6.0 * u - 15.0) + 10.0);
+  *ds = 30.0 * u * u * (1.0 - u) * (1.0 - u);
+  *dds = 60.0 * u * (1.0 - u) * (1.0 - 2.0 * u);
+}
+
+void EvaluateWindow(const CurveWindow& w, double t, Eigen::VectorXd* p, Eigen::VectorXd* v, Eigen::VectorXd* a) {
+  const double x = w.series.interval.ToUnit(t);
+  const double scale = w.series.interval.DerivativeScale();
+  *p = Clenshaw(w.series.coefficients, x).transpose();
+  *v = Clenshaw(w.first_derivative, x).transpose() * scale;
+  *a = Clenshaw(w.second_derivative, x).transpose() * (scale * scale);
+}
+
+}  // namespace
+
+Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen::MatrixXd>& values,
+               const CurveOptions& options) {
+  ValidateOptions(options);
+  const auto m = static_cast<Eigen::Index>(stamps_ns.size());
+  if (values.rows() != m) throw std::invalid_argument("FitCurve: stamps and values differ in length");
+  if (values.cols() < 1 || values.cols() > 4) throw std::invalid_argument("FitCurve: 1..4 coordinates");
+  if (m < 2) throw ComputeError(fmt::format("a fit needs at least 2 samples, got {}", m));
+
+  std::vector<Eigen::Index> order(m);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](Eigen::Index i, Eigen::Index j) { return stamps_ns[i] < stamps_ns[j]; });
+  Curve curve;
+  curve.origin_ns_ = stamps_ns[order.front()];
+  curve.dimension_ = static_cast<int>(values.cols());
+  Eigen::VectorXd t(m);
+  Eigen::MatrixXd z(m, values.cols());
+  for (Eigen::Index i = 0; i < m; ++i) {
+    t[i] = static_cast<double>(stamps_ns[order[i]] - curve.origin_ns_) * 1e-9;
+    z.row(i) = values.row(order[i]);
+  }
+  if (t[m - 1] == 0.0) throw ComputeError(fmt::format("all {} stamps are equal: there is no time to fit over", m));
+
+  std::vector<double> dts;
+  for (Eigen::Index i = 1; i < m; ++i) {
+    if (t[i] > t[i - 1]) dts.push_back(t[i] - t[i - 1]);
+  }
+  std::nth_element(dts.begin(), dts.begin() + static_cast<std::ptrdiff_t>(dts.size() / 2), dts.end());
+  const double gap = std::max(options.gap_factor * dts[dts.size() / 2], options.min_gap_s);
+
+  curve.noise_sigma_ = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
+                                           : EstimateNoiseSigma(z);
+  const WindowFitter fitter(t, z, curve.noise_sigma_, options);
+
+  // Segment boundaries [starts[k], starts[k+1]); a segment with one distinct stamp joins the
+  // neighbour across the shorter gap.
+  std::vector<Eigen::Index> starts{0};
+  for (Eigen::Index i = 1; i < m; ++i) {
+    if (t[i] - t[i - 1] > gap) starts.push_back(i);
+  }
+  starts.push_back(m);
+  for (size_t k = 0; k + 1 < starts.size() && starts.size() > 2;) {
+    if (t[starts[k + 1] - 1] != t[starts[k]]) {
+      ++k;
+      continue;
+    }
+    const double left_gap = k > 0 ? t[starts[k]] - t[starts[k] - 1] : std::numeric_limits<double>::infinity();
+    const double right_gap = k + 2 < starts.size() ? t[starts[k + 1]] - t[starts[k + 1] - 1]
+                                                   : std::numeric_limits<double>::infinity();
+    starts.erase(starts.begin() + static_cast<std::ptrdiff_t>(left_gap <= right_gap ? k : k + 1));
+    if (k > 0) --k;
+  }
+
+  for (size_t k = 0; k + 1 < starts.size(); ++k) {
+    CurveSegment segment;
+    segment.begin = t[starts[k]];
+    segment.end = t[starts[k + 1] - 1];
+    if (options.single_window || options.window_s) {
+      const int cores = options.single_window
+                            ? 1
+                            : std::max(1, static_cast<int>(std::lround((segment.end - segment.begin) / *options.window_s)));
+      for (int c = 0; c < cores; ++c) {
+        const double a = segment.begin + (segment.end - segment.begin) * c / cores;
+        const double b = c + 1 == cores ? segment.end : segment.begin + (segment.end - segment.begin) * (c + 1) / cores;
+        segment.windows.push_back(*fitter.Fit(a, b, segment.begin, segment.end, false));
+      }
+    } else {
+      // Adaptive: halve a core until its series resolves or it gets too small to split.
+      std::vector<std::pair<double, double>> stack{{segment.begin, segment.end}};
+      while (!stack.empty()) {
+        const auto [a, b] = stack.back();
+        stack.pop_back();
+        const auto inside = std::upper_bound(t.data(), t.data() + m, b) - std::lower_bound(t.data(), t.data() + m, a);
+        const bool may_split = inside >= 2 * options.min_window_samples;
+        std::optional<CurveWindow> window = fitter.Fit(a, b, segment.begin, segment.end, may_split);
+        if (window) {
+          segment.windows.push_back(std::move(*window));
+        } else {
+          const double middle = 0.5 * (a + b);
+          stack.emplace_back(middle, b);  // the left half is popped first: windows stay in time order
+          stack.emplace_back(a, middle);
+        }
+      }
+    }
+    curve.segments_.push_back(std::move(segment));
+  }
+
+  // Residuals at every sample.
+  Eigen::VectorXd p(values.cols()), v(values.cols()), a(values.cols());
+  Eigen::VectorXd squares = Eigen::VectorXd::Zero(values.cols());
+  for (Eigen::Index i = 0; i < m; ++i) {
+    curve.Evaluate(stamps_ns[order[i]], p, v, a);
+    squares += (p - z.row(i).transpose()).cwiseAbs2();
+  }
+  curve.residual_rms_ = (squares / static_cast<double>(m)).cwiseSqrt();
+  return curve;
+}
+
+void Curve::Evaluate(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value, Eigen::Ref<Eigen::VectorXd> derivative,
+                     Eigen::Ref<Eigen::VectorXd> second_derivative, double tolerance_s) const {
+  const double t = static_cast<double>(stamp_ns - origin_ns_) * 1e-9;
+  // The segment containing t (or nearest within the tolerance).
+  const CurveSegment* segment = nullptr;
+  for (const CurveSegment& s : segments_) {
+    if (t >= s.begin - tolerance_s && t <= s.end + tolerance_s) {
+      segment = &s;
+      break;
+    }
+  }
+  if (segment == nullptr) {
+    throw ComputeError(fmt::format("time {:.9f} s (from the first sample) is outside the fitted data or inside a gap",
+                                   t));
+  }
+  const auto& windows = segment->windows;
+  // The window whose core holds t.
+  auto it = std::upper_bound(windows.begin(), windows.end(), t,
+                             [](double time, const CurveWindow& w) { return time < w.core_begin; });
+  size_t k = it == windows.begin() ? 0 : static_cast<size_t>(it - windows.begin()) - 1;
+  Eigen::VectorXd p, v, a;
+  EvaluateWindow(windows[k], t, &p, &v, &a);
+  // Blend with the neighbour across the nearest core boundary when t is in the blending zone.
+  auto blend = [&](size_t left, size_t right) {
+    const double boundary = windows[right].core_begin;
+    // Half the overlap both windows have across the boundary: each is then well inside its data.
+    const double half = 0.5 * std::min(windows[left].fit_end - boundary, boundary - windows[right].fit_begin);
+    if (!(half > 0.0) || t < boundary - half || t > boundary + half) return false;
+    Eigen::VectorXd pl, vl, al, pr, vr, ar;
+    EvaluateWindow(windows[left], t, &pl, &vl, &al);
+    EvaluateWindow(windows[right], t, &pr, &vr, &ar);
+    double s, ds, dds;
+    Smoothstep((t - (boundary - half)) / (2.0 * half), &s, &ds, &dds);
+    ds /= 2.0 * half;
+    dds /= 4.0 * half * half;
+    p = (1.0 - s) * pl + s * pr;
+    v = (1.0 - s) * vl + s * vr + ds * (pr - pl);
+    a = (1.0 - s) * al + s * ar + 2.0 * ds * (vr - vl) + dds * (pr - pl);
+    return true;
+  };
+  if (!(k > 0 && blend(k - 1, k)) && k + 1 < windows.size()) blend(k, k + 1);
+  value = p;
+  derivative = v;
+  second_derivative = a;
+}
+
+Eigen::Index Curve::stored_values() const {
+  Eigen::Index total = 0;
+  for (const CurveSegment& s : segments_) {
+    for (const CurveWindow& w : s.windows) {
+      for (int degree : w.degrees) total += degree + 1;
+    }
+  }
+  return total;
+}
+
+}  // namespace cheval::cheb

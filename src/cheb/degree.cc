@@ -1,0 +1,76 @@
+#include "cheval/cheb/degree.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace cheval::cheb {
+
+int StandardChop(const Eigen::Ref<const Eigen::VectorXd>& coefficients, double tol) {
+  const int n = static_cast<int>(coefficients.size());
+  if (tol >= 1.0) return 1;
+  if (n < 17) return n;
+  // Step 1: the monotone envelope m_j = max_{k >= j} |c_k|, normalised by m_0.
+  std::vector<double> envelope(n);
+  envelope[n - 1] = std::abs(coefficients[n - 1]);
+  for (int j = n - 2; j >= 0; --j) envelope[j] = std::max(std::abs(coefficients[j]), envelope[j + 1]);
+  if (envelope[0] == 0.0) return 1;
+  for (double& e : envelope) e /= envelope.front();
+
+  // Step 2: the first plateau point j (1-based as in the paper): the envelope at j2 = round(1.25 j + 5)
+  // has not dropped much below its value at j, measured against log(tol).
+  int plateau_point = 0, j2 = 0;
+  for (int j = 2; j <= n; ++j) {
+    j2 = static_cast<int>(std::lround(1.25 * j + 5.0));
+    if (j2 > n) return n;  // no plateau: not resolved
+    const double e1 = envelope[j - 1], e2 = envelope[j2 - 1];
+    const double r = 3.0 * (1.0 - std::log(e1) / std::log(tol));
+    if (e1 == 0.0 || e2 / e1 > r) {
+      plateau_point = j - 1;
+      break;
+    }
+  }
+  if (plateau_point == 0) return n;
+  if (envelope[plateau_point - 1] == 0.0) return plateau_point;
+
+  // Step 3: cut at the minimum of log10(envelope) plus a linear tilt, before the plateau.
+  const double floor = std::pow(tol, 7.0 / 6.0);
+  int j3 = 0;
+  for (double e : envelope) j3 += e >= floor ? 1 : 0;
+  if (j3 < j2) {
+    j2 = j3 + 1;
+    envelope[j2 - 1] = floor;
+  }
+  int best = 1;
+  double best_value = std::numeric_limits<double>::infinity();
+  for (int i = 1; i <= j2; ++i) {
+    const double tilt = j2 > 1 ? (-1.0 / 3.0) * std::log10(tol) * (i - 1) / (j2 - 1) : 0.0;
+    const double value = std::log10(envelope[i - 1]) + tilt;
+    if (value < best_value) best_value = value, best = i;
+  }
+  return std::max(best - 1, 1);
+}
+
+Eigen::VectorXd EstimateNoiseSigma(const Eigen::Ref<const Eigen::MatrixXd>& z, int order) {
+  const Eigen::Index m = z.rows();
+  Eigen::VectorXd sigma = Eigen::VectorXd::Zero(z.cols());
+  if (m <= order) return sigma;
+  // C(2k, k): the variance gain of the k-th difference of white noise.
+  double gain = 1.0;
+  for (int i = 1; i <= order; ++i) gain = gain * (order + i) / i;
+  for (Eigen::Index c = 0; c < z.cols(); ++c) {
+    Eigen::VectorXd d = z.col(c);
+    for (int k = 0; k < order; ++k) {
+      for (Eigen::Index i = 0; i + 1 < d.size() - k; ++i) d[i] = d[i + 1] - d[i];
+    }
+    std::vector<double> magnitudes(static_cast<size_t>(m - order));
+    for (size_t i = 0; i < magnitudes.size(); ++i) magnitudes[i] = std::abs(d[static_cast<Eigen::Index>(i)]);
+    auto middle = magnitudes.begin() + static_cast<std::ptrdiff_t>(magnitudes.size() / 2);
+    std::nth_element(magnitudes.begin(), middle, magnitudes.end());
+    sigma[c] = 1.4826 * *middle / std::sqrt(gain);
+  }
+  return sigma;
+}
+
+}  // namespace cheval::cheb
