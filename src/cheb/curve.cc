@@ -16,6 +16,10 @@ namespace {
 // The relative tolerance below which coefficients are rounding, not signal: the chop's floor when
 // the data are noise-free.
 constexpr double kRoundingTolerance = 1e-13;
+// Largest condition number of the normal matrix accepted for the degree-choosing fit: 1e10 keeps
+// its coefficients accurate to ~1e-6 relative, far below any noise plateau the chop looks for.
+// Uneven sampling (holes inside a window) is what drives it up at a given N²/m.
+constexpr double kMaxGramCondition = 1e10;
 
 void ValidateOptions(const CurveOptions& o) {
   if (o.degree_method == DegreeMethod::kFixed && o.fixed_degree < 0) {
@@ -81,15 +85,36 @@ class WindowFitter {
       return window;
     }
 
-    const int top = static_cast<int>(std::min<double>(
+    int top = static_cast<int>(std::min<double>(
         {static_cast<double>(options_.max_degree), std::floor(std::sqrt(options_.max_conditioning * m)),
          static_cast<double>(distinct - 1)}));
-    const ChebyshevSeries high = FitLeastSquares(tw, zw, top, interval);
+    // The probe fit at the top degree; uneven sampling can make it ill-conditioned: then split the
+    // window if allowed, else lower the degree until it is well posed.
+    ChebyshevSeries high;
+    while (true) {
+      double condition = std::numeric_limits<double>::infinity();
+      try {
+        high = FitLeastSquares(tw, zw, top, interval, nullptr, &condition);
+      } catch (const ComputeError&) {
+      }
+      if (condition <= kMaxGramCondition) break;
+      if (may_split) return std::nullopt;
+      if (top <= 1) {
+        throw ComputeError(fmt::format("cannot fit the window {:.6f} s..{:.6f} s: its {} samples do not determine "
+                                       "even a line",
+                                       window.fit_begin, window.fit_end, m));
+      }
+      top = std::max(1, static_cast<int>(0.7 * top));
+    }
     window.coefficient_magnitudes = high.coefficients.cwiseAbs();
     bool resolved = true;
     if (options_.degree_method == DegreeMethod::kChop) {
       for (int c = 0; c < d; ++c) {
-        const Eigen::VectorXd coefficients = high.coefficients.col(c);
+        // The mean (c_0) says nothing about how well the motion is resolved, and a large offset
+        // (positions far from the origin) would make every other coefficient look negligible:
+        // the chop sees the series relative to the largest varying coefficient.
+        Eigen::VectorXd coefficients = high.coefficients.col(c);
+        coefficients[0] = top >= 1 ? coefficients.tail(top).cwiseAbs().maxCoeff() : 0.0;
         const double scale = coefficients.cwiseAbs().maxCoeff();
         if (scale == 0.0) continue;  // a constant zero coordinate: degree 0
         const double noise = sigma_[c] * std::sqrt(2.0 / static_cast<double>(m));

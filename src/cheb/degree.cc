@@ -15,8 +15,9 @@ int StandardChop(const Eigen::Ref<const Eigen::VectorXd>& coefficients, double t
   std::vector<double> envelope(n);
   envelope[n - 1] = std::abs(coefficients[n - 1]);
   for (int j = n - 2; j >= 0; --j) envelope[j] = std::max(std::abs(coefficients[j]), envelope[j + 1]);
-  if (envelope[0] == 0.0) return 1;
-  for (double& e : envelope) e /= envelope.front();
+  const double largest = envelope[0];
+  if (largest == 0.0) return 1;
+  for (double& e : envelope) e /= largest;
 
   // Step 2: the first plateau point j (1-based as in the paper): the envelope at j2 = round(1.25 j + 5)
   // has not dropped much below its value at j, measured against log(tol).

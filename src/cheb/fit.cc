@@ -101,7 +101,8 @@ void AccumulateAll(const Eigen::VectorXd& x, const Eigen::VectorXd& w, const Eig
 }  // namespace
 
 ChebyshevSeries FitLeastSquares(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
-                                int degree, const Interval& interval, const Eigen::VectorXd* weights) {
+                                int degree, const Interval& interval, const Eigen::VectorXd* weights,
+                                double* gram_condition) {
   const Eigen::Index m = t.size();
   const int d = static_cast<int>(z.cols());
   if (z.rows() != m) throw std::invalid_argument("FitLeastSquares: t and z have different lengths");
@@ -146,6 +147,7 @@ ChebyshevSeries FitLeastSquares(const Eigen::Ref<const Eigen::VectorXd>& t, cons
         "(too few distinct stamps?)",
         degree, m));
   }
+  if (gram_condition != nullptr) *gram_condition = ldlt.vectorD().maxCoeff() / ldlt.vectorD().minCoeff();
   ChebyshevSeries series;
   series.interval = interval;
   series.coefficients = ldlt.solve(b);

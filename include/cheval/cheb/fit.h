@@ -34,8 +34,11 @@ struct ChebyshevSeries {
 /// accurate while N²/m stays small (≲ 8 for equispaced samples), which the windowed fits ensure.
 ///
 /// `t` (m) are seconds relative to any local origin, inside `interval`; `z` is m x d with d <= 4.
-/// Throws ComputeError when fewer than N + 1 distinct stamps are given or the system is singular.
+/// Throws ComputeError when fewer than N + 1 samples are given or the system is singular (the
+/// LDLᵀ pivots span more than 1e13). If `gram_condition` is given it receives max/min of those
+/// pivots, an estimate of the normal matrix's condition number (the square of the samples').
 ChebyshevSeries FitLeastSquares(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
-                                int degree, const Interval& interval, const Eigen::VectorXd* weights = nullptr);
+                                int degree, const Interval& interval, const Eigen::VectorXd* weights = nullptr,
+                                double* gram_condition = nullptr);
 
 }  // namespace cheval::cheb
