@@ -116,7 +116,8 @@ class WindowFitter {
         Eigen::VectorXd coefficients = high.coefficients.col(c);
         coefficients[0] = top >= 1 ? coefficients.tail(top).cwiseAbs().maxCoeff() : 0.0;
         const double scale = coefficients.cwiseAbs().maxCoeff();
-        if (scale == 0.0) continue;  // a constant zero coordinate: degree 0
+        if (scale == 0.0) continue;  // a constant coordinate: degree 0
+        // Noise level of a coefficient of m equispaced samples: σ·sqrt(2/m) (CHEBYSHEV.md).
         const double noise = sigma_[c] * std::sqrt(2.0 / static_cast<double>(m));
         const double tol = std::clamp(noise / scale, kRoundingTolerance, 0.5);
         const int keep = StandardChop(coefficients, tol);
@@ -196,6 +197,37 @@ class WindowFitter {
   const Eigen::VectorXd& sigma_;
   const CurveOptions& options_;
 };
+
+// Halves the first and the last window of a segment while their degree exceeds
+// options.end_degree and they keep enough samples to be split.
+void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegment& segment,
+                const CurveOptions& options) {
+  if (options.end_degree <= 0) return;
+  auto max_degree = [](const CurveWindow& w) { return *std::max_element(w.degrees.begin(), w.degrees.end()); };
+  auto samples_in = [&t](double a, double b) {
+    return std::upper_bound(t.data(), t.data() + t.size(), b) - std::lower_bound(t.data(), t.data() + t.size(), a);
+  };
+  for (const bool front : {true, false}) {
+    while (true) {
+      auto& windows = segment.windows;
+      const CurveWindow& end = front ? windows.front() : windows.back();
+      if (max_degree(end) <= options.end_degree ||
+          samples_in(end.core_begin, end.core_end) < 2 * options.min_window_samples) {
+        break;
+      }
+      const double a = end.core_begin, b = end.core_end, middle = 0.5 * (a + b);
+      CurveWindow left = *fitter.Fit(a, middle, segment.begin, segment.end, false);
+      CurveWindow right = *fitter.Fit(middle, b, segment.begin, segment.end, false);
+      if (front) {
+        windows.front() = std::move(right);
+        windows.insert(windows.begin(), std::move(left));
+      } else {
+        windows.back() = std::move(left);
+        windows.push_back(std::move(right));
+      }
+    }
+  }
+}
 
 // Quintic smoothstep s(u) = 6u⁵ - 15u⁴ + 10u³ and its first two derivatives in u: C² blending.
 void Smoothstep(double u, double* s, double* ds, double* dds) {
@@ -297,6 +329,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
           stack.emplace_back(a, middle);
         }
       }
+      RefineEnds(fitter, t, segment, options);
     }
     curve.segments_.push_back(std::move(segment));
   }

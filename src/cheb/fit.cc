@@ -102,7 +102,7 @@ void AccumulateAll(const Eigen::VectorXd& x, const Eigen::VectorXd& w, const Eig
 
 ChebyshevSeries FitLeastSquares(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
                                 int degree, const Interval& interval, const Eigen::VectorXd* weights,
-                                double* gram_condition) {
+                                double* gram_condition, Eigen::VectorXd* variance_factors) {
   const Eigen::Index m = t.size();
   const int d = static_cast<int>(z.cols());
   if (z.rows() != m) throw std::invalid_argument("FitLeastSquares: t and z have different lengths");
@@ -148,6 +148,9 @@ ChebyshevSeries FitLeastSquares(const Eigen::Ref<const Eigen::VectorXd>& t, cons
         degree, m));
   }
   if (gram_condition != nullptr) *gram_condition = ldlt.vectorD().maxCoeff() / ldlt.vectorD().minCoeff();
+  if (variance_factors != nullptr) {
+    *variance_factors = ldlt.solve(Eigen::MatrixXd::Identity(degree + 1, degree + 1)).diagonal();
+  }
   ChebyshevSeries series;
   series.interval = interval;
   series.coefficients = ldlt.solve(b);

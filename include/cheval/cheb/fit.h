@@ -37,8 +37,10 @@ struct ChebyshevSeries {
 /// Throws ComputeError when fewer than N + 1 samples are given or the system is singular (the
 /// LDLᵀ pivots span more than 1e13). If `gram_condition` is given it receives max/min of those
 /// pivots, an estimate of the normal matrix's condition number (the square of the samples').
+/// If `variance_factors` is given it receives diag(G⁻¹): with unit weights and white noise of
+/// standard deviation σ on the samples, coefficient k has standard deviation σ·sqrt(factor_k).
 ChebyshevSeries FitLeastSquares(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
                                 int degree, const Interval& interval, const Eigen::VectorXd* weights = nullptr,
-                                double* gram_condition = nullptr);
+                                double* gram_condition = nullptr, Eigen::VectorXd* variance_factors = nullptr);
 
 }  // namespace cheval::cheb
