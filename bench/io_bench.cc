@@ -21,7 +21,7 @@ const traj::Trajectory& Motion(int64_t poses) {
   if (it == cache.end()) {
     sim::MotionOptions options;
     options.rate_hz = 200.0;
-    options.duration_s = static_cast<double>(poses - 1) / options.rate_hz;
+    options.duration_s = static_cast<double>(poses - 1) / *options.rate_hz;
     it = cache.emplace(poses, sim::AddPositionNoise(sim::GenerateMotion(options).View(), 0.001, 1)).first;
   }
   return it->second;

@@ -1,40 +1,148 @@
 #pragma once
 /// \file
-/// Synthetic motion with exact derivatives, for tests, demos and benchmarks. Every trajectory is an
-/// analytic function of time, so positions, velocities, orientations and body angular velocities
-/// are exact; measurement noise, if asked for, is added to a copy.
+/// Synthetic motion with exact derivatives, for tests, demos and benchmarks (docs/sim.md).
+///
+/// Every kind of motion is an analytic function of time. Positions p_world_body (m), world-frame
+/// velocities (m/s), orientations R_world_body and body-frame angular velocities (rad/s) are exact to
+/// rounding: derivatives come from truncated Taylor arithmetic (forward-mode differentiation of the
+/// closed forms), never from finite differences, and positions that are the integral of a designed
+/// velocity come from composite 16-point Gauss–Legendre quadrature, whose error on these smooth,
+/// slow integrands is far below double rounding. Frames: world z up; body x forward, y left, z up.
+///
+/// A MotionModel is the function of time; GenerateMotion samples it on its nominal grid (the truth),
+/// SampleMotion at any stamps, and Measure makes the measured copy: irregular (jittered) stamps,
+/// dropouts and gaps, with positions equal to the truth at each measured stamp plus Gaussian noise.
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
+#include <memory>
 #include <optional>
+#include <span>
 #include <string_view>
+#include <vector>
 
 #include "cheval/traj/trajectory.h"
 
 namespace cheval::sim {
 
-/// Kinds of synthetic motion. (kDrone is a Lissajous figure flown with yaw along the path and the
-/// roll/pitch a multirotor needs to accelerate; more kinds arrive with the velocity module.)
-enum class MotionKind { kDrone };
-
-std::string_view ToString(MotionKind kind);
-/// Parses a kind name ("drone"); nullopt if unknown.
-std::optional<MotionKind> MotionKindFromString(std::string_view name);
-
-/// Options of GenerateMotion. Validated by GenerateMotion (UsageError naming the option).
-struct MotionOptions {
-  MotionKind kind = MotionKind::kDrone;
-  double duration_s = 60.0;            ///< > 0
-  double rate_hz = 200.0;              ///< > 0, samples per second
-  int64_t start_stamp_ns = 1'403'636'580'000'000'000;  ///< absolute start (EuRoC-like epoch stamps)
-  uint64_t seed = 1;                   ///< seeds the noise and the shape's random phases
+/// Kinds of synthetic motion (docs/sim.md has the formulas and parameter ranges of each).
+enum class MotionKind {
+  kCar,       ///< road vehicle: 1.5–14.5 m/s with accelerations and brakings, smooth curvature,
+              ///< heading along the velocity, road grade, roll and pitch from the accelerations
+  kLegged,    ///< trotting quadruped body: ~0.35–0.9 m/s forward, 2–3 Hz vertical and lateral
+              ///< oscillation, roll/pitch/yaw oscillation at the gait frequency
+  kDrone,     ///< multirotor flying a figure-eight Lissajous with a peak speed of 8 m/s, yaw along the
+              ///< path, roll/pitch tilting the thrust axis along acceleration + gravity
+  kHandheld,  ///< camera carried by a walking person: wandering ~1 m/s path, 1.5–2 Hz step bounce of
+              ///< 2–4 cm, large yaw and pitch sweeps (peak body rates ~1.3–2 rad/s)
 };
 
-/// Exact motion sampled at `rate_hz` from `start_stamp_ns`: positions (m), unit quaternions,
-/// world-frame velocities (m/s) and body angular velocities (rad/s). Throws UsageError.
+/// The kind's name as the CLI spells it: "car", "legged", "drone", "handheld".
+std::string_view ToString(MotionKind kind);
+/// Parses a kind name as ToString spells it; nullopt if unknown.
+std::optional<MotionKind> MotionKindFromString(std::string_view name);
+
+/// Default duration and sampling rate of a kind's nominal grid.
+struct MotionDefaults {
+  double duration_s;  ///< seconds
+  double rate_hz;     ///< samples per second
+};
+
+/// Defaults of `kind`: car 100 s at 50 Hz, legged 10 s at 200 Hz, drone 60 s at 200 Hz, handheld
+/// 30 s at 100 Hz.
+MotionDefaults DefaultsFor(MotionKind kind);
+
+/// What to generate. Validated when a MotionModel is built (UsageError naming the CLI option).
+struct MotionOptions {
+  MotionKind kind = MotionKind::kDrone;                ///< --kind
+  std::optional<double> duration_s;                    ///< --duration, > 0 and <= 1e6 s; nullopt: the kind's default
+  std::optional<double> rate_hz;                       ///< --rate, > 0 Hz; nullopt: the kind's default
+  int64_t start_stamp_ns = 1'403'636'580'000'000'000;  ///< stamp of t = 0 (EuRoC-like epoch), |.| <= 4e18
+  uint64_t seed = 1;  ///< --seed: draws the shape's random parameters and every measurement effect
+};
+
+/// How the measured copy differs from the truth (Measure). Every effect has its own random stream
+/// derived from MotionOptions::seed, so e.g. changing the noise does not move the dropouts.
+struct MeasurementOptions {
+  double noise_m = 0.0;  ///< --noise: σ of N(0, σ²) added to each position coordinate, metres, >= 0
+  /// --jitter: σ in seconds of the Gaussian offset added to each nominal stamp (>= 0, < duration).
+  /// The jittered stamps are rounded to the nanosecond, sorted, and each one not above its
+  /// predecessor is moved to predecessor + 1 ns, so stamps strictly increase; positions are the truth
+  /// at the final stamps, so the order change (only when σ is a sizeable part of the period) costs
+  /// no exactness.
+  double jitter_s = 0.0;
+  double dropout_probability = 0.0;  ///< --dropout: each nominal sample is dropped with this probability, [0, 1)
+  /// --gap-count: number of longer gaps. The duration is cut into gap_count equal slots and one gap
+  /// of gap_s is placed uniformly at random inside each slot, one nominal period away from the slot
+  /// ends; nominal samples with stamp offset in [start, start + gap_s) are removed. >= 0.
+  int gap_count = 0;
+  double gap_s = 0.0;  ///< --gap-seconds: length of each gap, > 0 exactly when gap_count > 0
+};
+
+/// The exact state at one time.
+struct MotionState {
+  Eigen::Vector3d position;          ///< p_world_body, m
+  Eigen::Quaterniond orientation;    ///< R_world_body, unit norm (sign: as Eigen converts the matrix)
+  Eigen::Vector3d velocity;          ///< d/dt p_world_body in the world frame, m/s
+  Eigen::Vector3d angular_velocity;  ///< ω with Ṙ = R [ω]×, body frame, rad/s
+};
+
+/// One kind of motion with its random parameters fixed by the seed: an exact function of time,
+/// defined for every time (also before the start and after the duration). Cheap to copy (shared,
+/// immutable state); safe to evaluate from several threads.
+class MotionModel {
+ public:
+  /// Draws the kind's parameters from `options.seed` and fills in the kind's default duration and
+  /// rate where they are unset. Throws UsageError naming the option (e.g. "--rate must be a positive
+  /// number of Hz, got -1") for a non-positive or non-finite duration or rate, a duration above 1e6 s,
+  /// a grid of more than 1e8 samples, or a start stamp outside ±4e18 ns.
+  explicit MotionModel(const MotionOptions& options);
+
+  /// The options with the defaults filled in: duration_s and rate_hz always hold a value.
+  const MotionOptions& options() const;
+  /// The kind of motion (options().kind).
+  MotionKind kind() const { return options().kind; }
+
+  /// The exact state at `stamp_ns` (t = (stamp_ns - start_stamp_ns) · 1e-9 s, the difference taken
+  /// in int64, so it must not overflow: any stamp within ±5e18 ns qualifies).
+  MotionState StateAt(int64_t stamp_ns) const;
+  /// The exact state at `t_s` seconds after start_stamp_ns.
+  MotionState StateAtTime(double t_s) const;
+
+  /// The nominal grid: start_stamp_ns + round(i · 1e9 / rate_hz) ns for i = 0 .. floor(duration ·
+  /// rate) (so the last sample is at or just before the duration).
+  std::vector<int64_t> NominalStamps() const;
+
+ private:
+  struct Impl;
+  std::shared_ptr<const Impl> impl_;
+};
+
+/// The exact truth at arbitrary `stamps_ns` (any order; duplicates allowed): positions, unit
+/// quaternions, world-frame velocities and body angular velocities. Quaternion signs are kept
+/// continuous along the given order (each one has a non-negative dot product with its predecessor;
+/// the first has w >= 0), as a tracker would report them.
+traj::Trajectory SampleMotion(const MotionModel& model, std::span<const int64_t> stamps_ns);
+
+/// The truth on the model's nominal grid: SampleMotion(model, model.NominalStamps()).
+traj::Trajectory GenerateMotion(const MotionModel& model);
+/// GenerateMotion(MotionModel(options)). Throws UsageError as MotionModel does.
 traj::Trajectory GenerateMotion(const MotionOptions& options);
 
-/// A copy of `truth` without velocities, with N(0, sigma²) noise on every position coordinate
-/// (metres), drawn from a generator seeded with `seed`. sigma >= 0.
+/// The measured copy of `model` (positions and quaternions; no velocity channels): nominal grid
+/// samples are removed by the gaps and dropouts, the survivors' stamps jittered (see
+/// MeasurementOptions::jitter_s), and each position is the exact truth at its final stamp plus
+/// N(0, noise_m²) per coordinate; orientations are the exact truth (no orientation noise).
+/// Deterministic in the model's seed. Throws UsageError naming the option for a negative or
+/// non-finite noise or jitter, a jitter not below the duration, a dropout outside [0, 1), a negative
+/// gap count, gap seconds that are not positive exactly when the gap count is, gaps that do not fit
+/// in the duration, or when fewer than 2 samples would remain.
+traj::Trajectory Measure(const MotionModel& model, const MeasurementOptions& measurement);
+
+/// A copy of any `truth` without velocity channels and with N(0, sigma_m²) noise on every position
+/// coordinate (metres), drawn from a generator seeded with `seed`; stamps and orientations are kept.
+/// Throws UsageError ("--noise ...") unless sigma_m is finite and >= 0.
 traj::Trajectory AddPositionNoise(const traj::TrajectoryView& truth, double sigma_m, uint64_t seed);
 
 }  // namespace cheval::sim
