@@ -91,10 +91,11 @@ class WindowFitter {
     // The probe fit at the top degree; uneven sampling can make it ill-conditioned: then split the
     // window if allowed, else lower the degree until it is well posed.
     ChebyshevSeries high;
+    Eigen::VectorXd variance_factors;
     while (true) {
       double condition = std::numeric_limits<double>::infinity();
       try {
-        high = FitLeastSquares(tw, zw, top, interval, nullptr, &condition);
+        high = FitLeastSquares(tw, zw, top, interval, nullptr, &condition, &variance_factors);
       } catch (const ComputeError&) {
       }
       if (condition <= kMaxGramCondition) break;
@@ -108,7 +109,23 @@ class WindowFitter {
     }
     window.coefficient_magnitudes = high.coefficients.cwiseAbs();
     bool resolved = true;
-    if (options_.degree_method == DegreeMethod::kChop) {
+    if (options_.degree_method == DegreeMethod::kThreshold) {
+      const double universal = std::sqrt(2.0 * std::log(static_cast<double>(top + 1)));
+      for (int c = 0; c < d; ++c) {
+        int significant = 0;
+        for (int k = 1; k <= top; ++k) {
+          const double threshold = universal * sigma_[c] * std::sqrt(variance_factors[k]);
+          if (std::abs(high.coefficients(k, c)) > threshold) significant = k;
+        }
+        window.degrees[c] = significant;
+        // Significant coefficients up to the top: the motion is not resolved at this degree.
+        if (top >= 8 && significant > (top * 9) / 10) resolved = false;
+      }
+    } else {
+      // standardChop decides whether the window resolves the motion (its coefficients reach the
+      // noise plateau); it also picks the degree for kChop. Cross-validation picks the degree of a
+      // resolved window for kCrossValidation: held-out error alone cannot tell an unresolved window
+      // (every candidate underfits) from a resolved one.
       for (int c = 0; c < d; ++c) {
         // The mean (c_0) says nothing about how well the motion is resolved, and a large offset
         // (positions far from the origin) would make every other coefficient look negligible:
@@ -125,9 +142,9 @@ class WindowFitter {
         if (keep == top + 1) resolved = false;
         window.degrees[c] = keep - 1;
       }
-    } else {
-      for (int c = 0; c < d; ++c) window.degrees[c] = CrossValidatedDegree(tw, zw.col(c), top, interval);
-      resolved = *std::max_element(window.degrees.begin(), window.degrees.end()) < top;
+      if (options_.degree_method == DegreeMethod::kCrossValidation && (resolved || !may_split)) {
+        window.degrees = CrossValidatedDegrees(tw, zw, top, interval);
+      }
     }
     if (!resolved && may_split) return std::nullopt;
 
@@ -149,9 +166,11 @@ class WindowFitter {
   }
 
   // 5-fold cross-validation (folds interleaved: sample i in fold i mod 5) over a geometric grid
-  // of degrees up to `top`; returns the degree of least held-out squared error.
-  static int CrossValidatedDegree(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::VectorXd>& z,
-                                  int top, const Interval& interval) {
+  // of degrees up to `top`, per coordinate: the degree of least held-out squared error. Each fold
+  // builds its normal equations once at `top`; every candidate degree is a leading block.
+  static std::vector<int> CrossValidatedDegrees(const Eigen::Ref<const Eigen::VectorXd>& t,
+                                                const Eigen::Ref<const Eigen::MatrixXd>& z, int top,
+                                                const Interval& interval) {
     constexpr int kFolds = 5;
     std::vector<int> grid;
     for (double g = 2; g < top; g *= 1.25) {
@@ -159,37 +178,44 @@ class WindowFitter {
       if (grid.empty() || degree != grid.back()) grid.push_back(degree);
     }
     grid.push_back(top);
-    const Eigen::Index m = t.size();
-    int best = grid.front();
-    double best_error = std::numeric_limits<double>::infinity();
-    for (int degree : grid) {
-      double error = 0.0;
-      bool feasible = true;
-      for (int fold = 0; fold < kFolds && feasible; ++fold) {
-        std::vector<Eigen::Index> train;
-        for (Eigen::Index i = 0; i < m; ++i) {
-          if (i % kFolds != fold) train.push_back(i);
-        }
-        if (static_cast<Eigen::Index>(train.size()) < degree + 2) {
-          feasible = false;
-          break;
-        }
-        Eigen::VectorXd tt(train.size());
-        Eigen::MatrixXd zz(train.size(), 1);
-        for (size_t k = 0; k < train.size(); ++k) tt[k] = t[train[k]], zz(k, 0) = z[train[k]];
-        try {
-          const ChebyshevSeries fit = FitLeastSquares(tt, zz, degree, interval);
-          for (Eigen::Index i = fold; i < m; i += kFolds) {
-            const double r = fit.Value(t[i])[0] - z[i];
-            error += r * r;
-          }
-        } catch (const ComputeError&) {
-          feasible = false;
+    const Eigen::Index m = t.size(), d = z.cols();
+    Eigen::MatrixXd error = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(grid.size()), d);
+    for (int fold = 0; fold < kFolds; ++fold) {
+      const Eigen::Index test_count = (m - fold + kFolds - 1) / kFolds, train_count = m - test_count;
+      Eigen::VectorXd train_t(train_count), test_x(test_count);
+      Eigen::MatrixXd train_z(train_count, d), test_z(test_count, d);
+      for (Eigen::Index i = 0, a = 0, b = 0; i < m; ++i) {
+        if (i % kFolds == fold) {
+          test_x[b] = interval.ToUnit(t[i]);
+          test_z.row(b++) = z.row(i);
+        } else {
+          train_t[a] = t[i];
+          train_z.row(a++) = z.row(i);
         }
       }
-      if (feasible && error < best_error) best_error = error, best = degree;
+      const int fold_top = static_cast<int>(std::min<Eigen::Index>(top, train_count - 1));
+      const NormalEquations normal = BuildNormalEquations(train_t, train_z, fold_top, interval);
+      for (size_t g = 0; g < grid.size(); ++g) {
+        bool feasible = grid[g] <= fold_top;
+        if (feasible) {
+          try {
+            const ChebyshevSeries fit = SolveNormalEquations(normal, grid[g]);
+            error.row(static_cast<Eigen::Index>(g)) +=
+                (EvaluateSeries(fit.coefficients, test_x) - test_z).colwise().squaredNorm();
+          } catch (const ComputeError&) {
+            feasible = false;
+          }
+        }
+        if (!feasible) error.row(static_cast<Eigen::Index>(g)).setConstant(std::numeric_limits<double>::infinity());
+      }
     }
-    return best;
+    std::vector<int> degrees(static_cast<size_t>(d));
+    for (Eigen::Index c = 0; c < d; ++c) {
+      Eigen::Index best = 0;
+      error.col(c).minCoeff(&best);
+      degrees[static_cast<size_t>(c)] = grid[static_cast<size_t>(best)];
+    }
+    return degrees;
   }
 
   const Eigen::VectorXd& t_;
@@ -198,8 +224,33 @@ class WindowFitter {
   const CurveOptions& options_;
 };
 
+// Fits cores [a, b] of a segment adaptively: a core is halved until its series resolves or it
+// gets too small to split. Windows come out in time order.
+std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::VectorXd& t, const CurveSegment& segment,
+                                     double a0, double b0, const CurveOptions& options) {
+  std::vector<CurveWindow> windows;
+  std::vector<std::pair<double, double>> stack{{a0, b0}};
+  while (!stack.empty()) {
+    const auto [a, b] = stack.back();
+    stack.pop_back();
+    const auto inside =
+        std::upper_bound(t.data(), t.data() + t.size(), b) - std::lower_bound(t.data(), t.data() + t.size(), a);
+    const bool may_split = inside >= 2 * options.min_window_samples;
+    std::optional<CurveWindow> window = fitter.Fit(a, b, segment.begin, segment.end, may_split);
+    if (window) {
+      windows.push_back(std::move(*window));
+    } else {
+      const double middle = 0.5 * (a + b);
+      stack.emplace_back(middle, b);  // the left half is popped first: windows stay in time order
+      stack.emplace_back(a, middle);
+    }
+  }
+  return windows;
+}
+
 // Halves the first and the last window of a segment while their degree exceeds
-// options.end_degree and they keep enough samples to be split.
+// options.end_degree and they keep enough samples to be split; the inner half is refitted
+// adaptively (it may need splitting itself).
 void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegment& segment,
                 const CurveOptions& options) {
   if (options.end_degree <= 0) return;
@@ -216,14 +267,18 @@ void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegme
         break;
       }
       const double a = end.core_begin, b = end.core_end, middle = 0.5 * (a + b);
-      CurveWindow left = *fitter.Fit(a, middle, segment.begin, segment.end, false);
-      CurveWindow right = *fitter.Fit(middle, b, segment.begin, segment.end, false);
       if (front) {
-        windows.front() = std::move(right);
-        windows.insert(windows.begin(), std::move(left));
+        CurveWindow outer = *fitter.Fit(a, middle, segment.begin, segment.end, false);
+        std::vector<CurveWindow> inner = FitAdaptive(fitter, t, segment, middle, b, options);
+        windows.erase(windows.begin());
+        windows.insert(windows.begin(), std::make_move_iterator(inner.begin()), std::make_move_iterator(inner.end()));
+        windows.insert(windows.begin(), std::move(outer));
       } else {
-        windows.back() = std::move(left);
-        windows.push_back(std::move(right));
+        std::vector<CurveWindow> inner = FitAdaptive(fitter, t, segment, a, middle, options);
+        CurveWindow outer = *fitter.Fit(middle, b, segment.begin, segment.end, false);
+        windows.pop_back();
+        windows.insert(windows.end(), std::make_move_iterator(inner.begin()), std::make_move_iterator(inner.end()));
+        windows.push_back(std::move(outer));
       }
     }
   }
@@ -313,22 +368,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
         segment.windows.push_back(*fitter.Fit(a, b, segment.begin, segment.end, false));
       }
     } else {
-      // Adaptive: halve a core until its series resolves or it gets too small to split.
-      std::vector<std::pair<double, double>> stack{{segment.begin, segment.end}};
-      while (!stack.empty()) {
-        const auto [a, b] = stack.back();
-        stack.pop_back();
-        const auto inside = std::upper_bound(t.data(), t.data() + m, b) - std::lower_bound(t.data(), t.data() + m, a);
-        const bool may_split = inside >= 2 * options.min_window_samples;
-        std::optional<CurveWindow> window = fitter.Fit(a, b, segment.begin, segment.end, may_split);
-        if (window) {
-          segment.windows.push_back(std::move(*window));
-        } else {
-          const double middle = 0.5 * (a + b);
-          stack.emplace_back(middle, b);  // the left half is popped first: windows stay in time order
-          stack.emplace_back(a, middle);
-        }
-      }
+      segment.windows = FitAdaptive(fitter, t, segment, segment.begin, segment.end, options);
       RefineEnds(fitter, t, segment, options);
     }
     curve.segments_.push_back(std::move(segment));

@@ -100,61 +100,94 @@ void AccumulateAll(const Eigen::VectorXd& x, const Eigen::VectorXd& w, const Eig
 
 }  // namespace
 
-ChebyshevSeries FitLeastSquares(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
-                                int degree, const Interval& interval, const Eigen::VectorXd* weights,
-                                double* gram_condition, Eigen::VectorXd* variance_factors) {
+NormalEquations BuildNormalEquations(const Eigen::Ref<const Eigen::VectorXd>& t,
+                                     const Eigen::Ref<const Eigen::MatrixXd>& z, int top, const Interval& interval,
+                                     const Eigen::VectorXd* weights) {
   const Eigen::Index m = t.size();
   const int d = static_cast<int>(z.cols());
-  if (z.rows() != m) throw std::invalid_argument("FitLeastSquares: t and z have different lengths");
-  if (d < 1 || d > 4) throw std::invalid_argument("FitLeastSquares: dimension must be 1..4");
-  if (degree < 0) throw std::invalid_argument("FitLeastSquares: negative degree");
-  if (weights != nullptr && weights->size() != m) throw std::invalid_argument("FitLeastSquares: weights length");
-  if (m < degree + 1) {
-    throw ComputeError(fmt::format("a degree-{} fit needs at least {} samples, got {}", degree, degree + 1, m));
+  if (z.rows() != m) throw std::invalid_argument("BuildNormalEquations: t and z have different lengths");
+  if (d < 1 || d > 4) throw std::invalid_argument("BuildNormalEquations: dimension must be 1..4");
+  if (top < 0) throw std::invalid_argument("BuildNormalEquations: negative degree");
+  if (weights != nullptr && weights->size() != m) throw std::invalid_argument("BuildNormalEquations: weights length");
+  if (m < top + 1) {
+    throw ComputeError(fmt::format("a degree-{} fit needs at least {} samples, got {}", top, top + 1, m));
   }
   Eigen::VectorXd x(m);
   for (Eigen::Index i = 0; i < m; ++i) x[i] = interval.ToUnit(t[i]);
   const Eigen::VectorXd w = weights != nullptr ? *weights : Eigen::VectorXd::Ones(m);
   Moments moments;
-  moments.s.assign(2 * degree + 2, 0.0);
-  moments.squares.assign(degree + 1, 0.0);
-  moments.products.assign(degree + 1, 0.0);
-  moments.b = Eigen::MatrixXd::Zero(degree + 1, d);
+  moments.s.assign(2 * top + 2, 0.0);
+  moments.squares.assign(top + 1, 0.0);
+  moments.products.assign(top + 1, 0.0);
+  moments.b = Eigen::MatrixXd::Zero(top + 1, d);
   switch (d) {
-    case 1: AccumulateAll<1>(x, w, z, degree, &moments); break;
-    case 2: AccumulateAll<2>(x, w, z, degree, &moments); break;
-    case 3: AccumulateAll<3>(x, w, z, degree, &moments); break;
-    case 4: AccumulateAll<4>(x, w, z, degree, &moments); break;
-    default: throw std::invalid_argument("FitLeastSquares: dimension must be 1..4");
+    case 1: AccumulateAll<1>(x, w, z, top, &moments); break;
+    case 2: AccumulateAll<2>(x, w, z, top, &moments); break;
+    case 3: AccumulateAll<3>(x, w, z, top, &moments); break;
+    default: AccumulateAll<4>(x, w, z, top, &moments); break;
   }
-  Eigen::VectorXd s(2 * degree + 1);
-  for (int n = 0; n <= degree; ++n) s[n] = moments.s[n];
-  const double s0 = moments.s[0], s1 = degree >= 1 ? moments.s[1] : 0.0;
-  for (int n = 1; 2 * n <= 2 * degree; ++n) {
-    if (2 * n > degree) s[2 * n] = 2.0 * moments.squares[n] - s0;
-    if (2 * n + 1 > degree && 2 * n + 1 <= 2 * degree) s[2 * n + 1] = 2.0 * moments.products[n] - s1;
+  Eigen::VectorXd s(2 * top + 1);
+  for (int n = 0; n <= top; ++n) s[n] = moments.s[n];
+  const double s0 = moments.s[0], s1 = top >= 1 ? moments.s[1] : 0.0;
+  for (int n = 1; n <= top; ++n) {
+    if (2 * n > top) s[2 * n] = 2.0 * moments.squares[n] - s0;
+    if (2 * n + 1 > top && 2 * n + 1 <= 2 * top) s[2 * n + 1] = 2.0 * moments.products[n] - s1;
   }
-  const Eigen::MatrixXd& b = moments.b;
-  Eigen::MatrixXd gram(degree + 1, degree + 1);
-  for (int i = 0; i <= degree; ++i) {
-    for (int j = 0; j <= degree; ++j) gram(i, j) = 0.5 * (s[i + j] + s[std::abs(i - j)]);
+  NormalEquations normal;
+  normal.interval = interval;
+  normal.samples = m;
+  normal.rhs = std::move(moments.b);
+  normal.gram.resize(top + 1, top + 1);
+  for (int i = 0; i <= top; ++i) {
+    for (int j = 0; j <= top; ++j) normal.gram(i, j) = 0.5 * (s[i + j] + s[std::abs(i - j)]);
   }
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(gram);
+  return normal;
+}
+
+ChebyshevSeries SolveNormalEquations(const NormalEquations& normal, int degree, double* gram_condition,
+                                     Eigen::VectorXd* variance_factors) {
+  if (degree < 0 || degree > normal.top_degree()) {
+    throw std::invalid_argument("SolveNormalEquations: degree outside the normal equations");
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(normal.gram.topLeftCorner(degree + 1, degree + 1));
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive() ||
       ldlt.vectorD().minCoeff() <= 1e-13 * ldlt.vectorD().maxCoeff()) {
     throw ComputeError(fmt::format(
         "the degree-{} least-squares fit is singular: {} samples do not determine the polynomial "
         "(too few distinct stamps?)",
-        degree, m));
+        degree, normal.samples));
   }
   if (gram_condition != nullptr) *gram_condition = ldlt.vectorD().maxCoeff() / ldlt.vectorD().minCoeff();
   if (variance_factors != nullptr) {
     *variance_factors = ldlt.solve(Eigen::MatrixXd::Identity(degree + 1, degree + 1)).diagonal();
   }
   ChebyshevSeries series;
-  series.interval = interval;
-  series.coefficients = ldlt.solve(b);
+  series.interval = normal.interval;
+  series.coefficients = ldlt.solve(normal.rhs.topRows(degree + 1));
   return series;
+}
+
+ChebyshevSeries FitLeastSquares(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
+                                int degree, const Interval& interval, const Eigen::VectorXd* weights,
+                                double* gram_condition, Eigen::VectorXd* variance_factors) {
+  return SolveNormalEquations(BuildNormalEquations(t, z, degree, interval, weights), degree, gram_condition,
+                              variance_factors);
+}
+
+Eigen::MatrixXd EvaluateSeries(const Eigen::Ref<const Eigen::MatrixXd>& coefficients,
+                               const Eigen::Ref<const Eigen::VectorXd>& x) {
+  const Eigen::Index n = coefficients.rows() - 1, m = x.size(), d = coefficients.cols();
+  Eigen::MatrixXd b1 = Eigen::MatrixXd::Zero(m, d), b2 = Eigen::MatrixXd::Zero(m, d), b0(m, d);
+  const Eigen::VectorXd two_x = 2.0 * x;
+  for (Eigen::Index k = n; k >= 1; --k) {
+    b0 = two_x.asDiagonal() * b1 - b2;
+    b0.rowwise() += coefficients.row(k);
+    b2.swap(b1);
+    b1.swap(b0);
+  }
+  Eigen::MatrixXd result = x.asDiagonal() * b1 - b2;
+  result.rowwise() += coefficients.row(0);
+  return result;
 }
 
 }  // namespace cheval::cheb

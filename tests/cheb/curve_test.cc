@@ -110,10 +110,12 @@ TEST(FitCurve, NoisyBeatsCentralDifferencesByFarAndEstimatesTheNoise) {
   EXPECT_LT(cheb, 15e-3);
 }
 
-TEST(FitCurve, CrossValidationAlsoWorks) {
+TEST(FitCurve, StandardChopAndThresholdAlsoWork) {
   const Samples s = Sample(30.0, 100.0, 1e-3, 3);
   CurveOptions options;
-  options.degree_method = DegreeMethod::kCrossValidation;
+  options.degree_method = DegreeMethod::kChop;
+  EXPECT_LT(VelocityRmse(FitCurve(s.stamps, s.values, options), s), 0.2 * CentralDifferenceRmse(s));
+  options.degree_method = DegreeMethod::kThreshold;
   const Curve curve = FitCurve(s.stamps, s.values, options);
   EXPECT_LT(VelocityRmse(curve, s), 0.2 * CentralDifferenceRmse(s));
 }

@@ -43,15 +43,18 @@ std::vector<int64_t> ReadQueryStamps(const std::string& path) {
 eval::VelocityOptions ToOptions(const VelocityFlags& flags, const traj::TrajectoryView& trajectory) {
   eval::VelocityOptions options;
   options.method = *eval::VelocityMethodFromString(flags.method);
-  if (flags.degree == "auto") {
-    options.curve.degree_method = cheb::DegreeMethod::kChop;
-  } else if (flags.degree == "cv") {
+  if (flags.degree == "auto" || flags.degree == "cv") {
     options.curve.degree_method = cheb::DegreeMethod::kCrossValidation;
+  } else if (flags.degree == "chop") {
+    options.curve.degree_method = cheb::DegreeMethod::kChop;
+  } else if (flags.degree == "threshold") {
+    options.curve.degree_method = cheb::DegreeMethod::kThreshold;
   } else {
     int degree = -1;
     const auto [end, ec] = std::from_chars(flags.degree.data(), flags.degree.data() + flags.degree.size(), degree);
     if (ec != std::errc() || end != flags.degree.data() + flags.degree.size() || degree < 0) {
-      throw UsageError(fmt::format("--degree: expected auto, cv or a non-negative integer, got '{}'", flags.degree));
+      throw UsageError(
+          fmt::format("--degree: expected auto, cv, chop, threshold or a non-negative integer, got '{}'", flags.degree));
     }
     options.curve.degree_method = cheb::DegreeMethod::kFixed;
     options.curve.fixed_degree = degree;
@@ -124,7 +127,8 @@ void RegisterVelocity(CLI::App& app, Action* action) {
       ->check(CLI::IsMember({"chebyshev", "central", "savgol"}))
       ->capture_default_str();
   command->add_option("--degree", flags->degree,
-                      "chebyshev: auto (standardChop on the noise level), cv (cross-validation) or a fixed degree")
+                      "chebyshev: auto = cv (5-fold cross-validation per window), chop (standardChop at the "
+                      "estimated noise level), threshold (universal threshold on the coefficients) or a fixed degree")
       ->capture_default_str();
   command->add_option("--window", flags->window_s,
                       "chebyshev: fixed window length in seconds (default: adaptive); savgol: window in seconds "

@@ -17,14 +17,22 @@ namespace cheval::cheb {
 
 /// How the degree of each window is chosen.
 enum class DegreeMethod {
-  kChop,             ///< standardChop on a high-degree fit, tolerance from the estimated noise (default)
-  kCrossValidation,  ///< 5-fold cross-validation over a grid of degrees
-  kFixed,            ///< the given degree in every window
+  /// 5-fold cross-validation over a geometric grid of degrees, per coordinate (default: the most
+  /// accurate velocity on every synthetic kind of bench/velocity_accuracy, docs/velocity.md).
+  kCrossValidation,
+  /// Chebfun's standardChop on a high-degree fit, tolerance σ·sqrt(2/m) relative to the largest
+  /// varying coefficient, σ the (estimated) noise.
+  kChop,
+  /// The last coefficient of a high-degree fit that stands out of the noise: |c_k| above the
+  /// universal threshold σ_k·sqrt(2 ln K) (Donoho & Johnstone 1994), σ_k = σ·sqrt((G⁻¹)_kk) the
+  /// coefficient's own noise level and K the number of coefficients.
+  kThreshold,
+  kFixed,  ///< the given degree in every window
 };
 
 /// Options of FitCurve; defaults need no tuning.
 struct CurveOptions {
-  DegreeMethod degree_method = DegreeMethod::kChop;
+  DegreeMethod degree_method = DegreeMethod::kCrossValidation;
   /// kFixed: the degree. With a single window this is the classic global fit.
   int fixed_degree = 0;
   /// Fixed window length (s); nullopt = adaptive: windows are halved until their series resolve.
@@ -46,12 +54,12 @@ struct CurveOptions {
   /// Noise standard deviation of the samples (same unit as them); nullopt = estimated from the data.
   std::optional<double> noise_sigma;
   /// The derivative of a least-squares polynomial is noisiest at the ends of its interval, and
-  /// more so the higher its degree (the variance at an end grows like N⁴/m). With end_degree > 0
-  /// the first and last window of every segment are halved until their degree is at most this
-  /// (or they reach min_window_samples): a graded mesh towards the ends. Off by default: measured
-  /// on the synthetic drone it makes the full-range velocity worse (1.4 -> 3.7 mm/s at 2 mm noise),
-  /// on a signal with 1 Hz content better (9.1 -> 3.3 mm/s at 1 mm); see docs/velocity.md.
-  int end_degree = 0;
+  /// more so the higher its degree (the variance at an end grows like N⁴/m). The first and last
+  /// window of every segment are therefore halved until their degree is at most end_degree (or
+  /// they reach min_window_samples): a graded mesh towards the ends. 0 disables it. 20 had the
+  /// best geometric-mean full-range error over the synthetic kinds of bench/velocity_accuracy
+  /// among 0, 10 and 20 (docs/velocity.md).
+  int end_degree = 20;
   /// Fit a single window over each gap-free segment (no splitting), e.g. to reproduce a global fit.
   bool single_window = false;
 };

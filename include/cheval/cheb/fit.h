@@ -25,22 +25,47 @@ struct ChebyshevSeries {
   Eigen::MatrixXd ValuesAtPoints() const;
 };
 
-/// Fits samples z_i ≈ p(t_i) in the least-squares sense with weights ω_i (nullptr = all 1):
-/// minimises Σ ω_i |z_i - p(t_i)|² over polynomials p of degree N on `interval`.
+/// The normal equations of a weighted least-squares Chebyshev fit up to degree `top`: the fit of
+/// any lower degree N uses their leading (N + 1) x (N + 1) block and first N + 1 rows, so one
+/// O(m·top) pass over the samples serves every candidate degree.
 ///
 /// In the coefficient basis the normal matrix is Toeplitz-plus-Hankel,
 /// G_ij = (S_{i+j} + S_{|i-j|}) / 2 with S_n = Σ ω_i T_n(x_i), so building it and the right-hand
-/// side costs O(m·N) and the solve O(N³). Normal equations square the condition number: this is
+/// side costs O(m·N) and a solve O(N³). Normal equations square the condition number: this is
 /// accurate while N²/m stays small (≲ 8 for equispaced samples), which the windowed fits ensure.
-///
-/// `t` (m) are seconds relative to any local origin, inside `interval`; `z` is m x d with d <= 4.
-/// Throws ComputeError when fewer than N + 1 samples are given or the system is singular (the
-/// LDLᵀ pivots span more than 1e13). If `gram_condition` is given it receives max/min of those
-/// pivots, an estimate of the normal matrix's condition number (the square of the samples').
-/// If `variance_factors` is given it receives diag(G⁻¹): with unit weights and white noise of
-/// standard deviation σ on the samples, coefficient k has standard deviation σ·sqrt(factor_k).
+struct NormalEquations {
+  Interval interval;
+  Eigen::MatrixXd gram;  ///< (top + 1) x (top + 1)
+  Eigen::MatrixXd rhs;   ///< (top + 1) x d: Σ ω_i T_k(x_i) z_i
+  Eigen::Index samples = 0;
+  int top_degree() const { return static_cast<int>(gram.rows()) - 1; }
+};
+
+/// Builds the normal equations of samples z_i at t_i (seconds relative to any local origin,
+/// inside `interval`; z is m x d with d <= 4) with weights ω_i (nullptr = all 1), up to `top`.
+/// Throws ComputeError when fewer than top + 1 samples are given.
+NormalEquations BuildNormalEquations(const Eigen::Ref<const Eigen::VectorXd>& t,
+                                     const Eigen::Ref<const Eigen::MatrixXd>& z, int top, const Interval& interval,
+                                     const Eigen::VectorXd* weights = nullptr);
+
+/// Solves the degree-N fit from normal equations built up to at least N. Throws ComputeError when
+/// the system is singular (LDLᵀ pivots spanning more than 1e13). If `gram_condition` is given it
+/// receives max/min of those pivots, an estimate of the normal matrix's condition number (the square
+/// of the samples'). If `variance_factors` is given it receives diag(G⁻¹): with unit weights and
+/// white noise of standard deviation σ, coefficient k has standard deviation σ·sqrt(factor_k).
+ChebyshevSeries SolveNormalEquations(const NormalEquations& normal, int degree, double* gram_condition = nullptr,
+                                     Eigen::VectorXd* variance_factors = nullptr);
+
+/// Fits samples z_i ≈ p(t_i) in the least-squares sense with weights ω_i (nullptr = all 1):
+/// minimises Σ ω_i |z_i - p(t_i)|² over polynomials p of degree N on `interval`
+/// (BuildNormalEquations + SolveNormalEquations).
 ChebyshevSeries FitLeastSquares(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
                                 int degree, const Interval& interval, const Eigen::VectorXd* weights = nullptr,
                                 double* gram_condition = nullptr, Eigen::VectorXd* variance_factors = nullptr);
+
+/// Values of the series with coefficients ((N + 1) x d) at every x (unit interval): m x d, by
+/// Clenshaw's recurrence over all points at once.
+Eigen::MatrixXd EvaluateSeries(const Eigen::Ref<const Eigen::MatrixXd>& coefficients,
+                               const Eigen::Ref<const Eigen::VectorXd>& x);
 
 }  // namespace cheval::cheb
