@@ -95,7 +95,8 @@ class WindowFitter {
     while (true) {
       double condition = std::numeric_limits<double>::infinity();
       try {
-        high = FitLeastSquares(tw, zw, top, interval, nullptr, &condition, &variance_factors);
+        high = FitLeastSquares(tw, zw, top, interval, nullptr, &condition,
+                               options_.degree_method == DegreeMethod::kThreshold ? &variance_factors : nullptr);
       } catch (const ComputeError&) {
       }
       if (condition <= kMaxGramCondition) break;
@@ -148,11 +149,15 @@ class WindowFitter {
     }
     if (!resolved && may_split) return std::nullopt;
 
+    // Each coordinate at its own degree, from one set of normal equations (leading blocks).
     const int degree = *std::max_element(window.degrees.begin(), window.degrees.end());
+    NormalEquations normal = BuildNormalEquations(tw, zw, degree, interval);
     window.series.interval = interval;
     window.series.coefficients = Eigen::MatrixXd::Zero(degree + 1, d);
+    const Eigen::MatrixXd rhs = normal.rhs;
     for (int c = 0; c < d; ++c) {
-      const ChebyshevSeries axis = FitLeastSquares(tw, zw.col(c), window.degrees[c], interval);
+      normal.rhs = rhs.col(c);
+      const ChebyshevSeries axis = SolveNormalEquations(normal, window.degrees[c]);
       window.series.coefficients.col(c).head(window.degrees[c] + 1) = axis.coefficients.col(0);
     }
     Finish(&window);
@@ -292,12 +297,32 @@ void Smoothstep(double u, double* s, double* ds, double* dds) {
   *dds = 60.0 * u * (1.0 - u) * (1.0 - 2.0 * u);
 }
 
-void EvaluateWindow(const CurveWindow& w, double t, Eigen::VectorXd* p, Eigen::VectorXd* v, Eigen::VectorXd* a) {
+// Up to 4 coordinates, on the stack: evaluation allocates nothing.
+using Point = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 4, 1>;
+
+// Σ_k c_k T_k(x) for each column of `coefficients`, times `scale`, into `out`.
+void ClenshawInto(const Eigen::MatrixXd& coefficients, double x, double scale, Point* out) {
+  const Eigen::Index n = coefficients.rows() - 1, d = coefficients.cols();
+  out->resize(d);
+  const double two_x = 2.0 * x;
+  for (Eigen::Index c = 0; c < d; ++c) {
+    const double* a = coefficients.col(c).data();
+    double b1 = 0.0, b2 = 0.0;
+    for (Eigen::Index k = n; k >= 1; --k) {
+      const double b0 = two_x * b1 - b2 + a[k];
+      b2 = b1;
+      b1 = b0;
+    }
+    (*out)[c] = (x * b1 - b2 + a[0]) * scale;
+  }
+}
+
+void EvaluateWindow(const CurveWindow& w, double t, Point* p, Point* v, Point* a) {
   const double x = w.series.interval.ToUnit(t);
   const double scale = w.series.interval.DerivativeScale();
-  *p = Clenshaw(w.series.coefficients, x).transpose();
-  *v = Clenshaw(w.first_derivative, x).transpose() * scale;
-  *a = Clenshaw(w.second_derivative, x).transpose() * (scale * scale);
+  ClenshawInto(w.series.coefficients, x, 1.0, p);
+  ClenshawInto(w.first_derivative, x, scale, v);
+  ClenshawInto(w.second_derivative, x, scale * scale, a);
 }
 
 }  // namespace
@@ -405,7 +430,7 @@ void Curve::Evaluate(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value, Eigen:
   auto it = std::upper_bound(windows.begin(), windows.end(), t,
                              [](double time, const CurveWindow& w) { return time < w.core_begin; });
   size_t k = it == windows.begin() ? 0 : static_cast<size_t>(it - windows.begin()) - 1;
-  Eigen::VectorXd p, v, a;
+  Point p, v, a;
   EvaluateWindow(windows[k], t, &p, &v, &a);
   // Blend with the neighbour across the nearest core boundary when t is in the blending zone.
   auto blend = [&](size_t left, size_t right) {
@@ -413,7 +438,7 @@ void Curve::Evaluate(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value, Eigen:
     // Half the overlap both windows have across the boundary: each is then well inside its data.
     const double half = 0.5 * std::min(windows[left].fit_end - boundary, boundary - windows[right].fit_begin);
     if (!(half > 0.0) || t < boundary - half || t > boundary + half) return false;
-    Eigen::VectorXd pl, vl, al, pr, vr, ar;
+    Point pl, vl, al, pr, vr, ar;
     EvaluateWindow(windows[left], t, &pl, &vl, &al);
     EvaluateWindow(windows[right], t, &pr, &vr, &ar);
     double s, ds, dds;

@@ -177,16 +177,26 @@ ChebyshevSeries FitLeastSquares(const Eigen::Ref<const Eigen::VectorXd>& t, cons
 Eigen::MatrixXd EvaluateSeries(const Eigen::Ref<const Eigen::MatrixXd>& coefficients,
                                const Eigen::Ref<const Eigen::VectorXd>& x) {
   const Eigen::Index n = coefficients.rows() - 1, m = x.size(), d = coefficients.cols();
-  Eigen::MatrixXd b1 = Eigen::MatrixXd::Zero(m, d), b2 = Eigen::MatrixXd::Zero(m, d), b0(m, d);
-  const Eigen::VectorXd two_x = 2.0 * x;
-  for (Eigen::Index k = n; k >= 1; --k) {
-    b0 = two_x.asDiagonal() * b1 - b2;
-    b0.rowwise() += coefficients.row(k);
-    b2.swap(b1);
-    b1.swap(b0);
+  Eigen::MatrixXd result(m, d);
+  // kLanes points at a time: independent Clenshaw chains the compiler vectorises (one chain alone
+  // is bound by the latency of its multiply-add).
+  for (Eigen::Index c = 0; c < d; ++c) {
+    const double* a = coefficients.col(c).data();
+    for (Eigen::Index begin = 0; begin < m; begin += kLanes) {
+      const int count = static_cast<int>(std::min<Eigen::Index>(kLanes, m - begin));
+      double xs[kLanes], b1[kLanes] = {}, b2[kLanes] = {};
+      for (int l = 0; l < kLanes; ++l) xs[l] = l < count ? x[begin + l] : 0.0;
+      for (Eigen::Index k = n; k >= 1; --k) {
+        const double ak = a[k];
+        for (int l = 0; l < kLanes; ++l) {
+          const double b0 = 2.0 * xs[l] * b1[l] - b2[l] + ak;
+          b2[l] = b1[l];
+          b1[l] = b0;
+        }
+      }
+      for (int l = 0; l < count; ++l) result(begin + l, c) = xs[l] * b1[l] - b2[l] + a[0];
+    }
   }
-  Eigen::MatrixXd result = x.asDiagonal() * b1 - b2;
-  result.rowwise() += coefficients.row(0);
   return result;
 }
 
