@@ -171,8 +171,11 @@ class WindowFitter {
   }
 
   // 5-fold cross-validation (folds interleaved: sample i in fold i mod 5) over a geometric grid
-  // of degrees up to `top`, per coordinate: the degree of least held-out squared error. Each fold
-  // builds its normal equations once at `top`; every candidate degree is a leading block.
+  // of degrees up to `top`, per coordinate: the degree of least held-out squared error.
+  // Nothing is evaluated point by point: with F_f the normal equations (G_f, b_f) and Σz² of fold
+  // f, the training system of fold f is Σ F - F_f, and the held-out error of coefficients c is
+  // Σz²_f - 2 cᵀb_f + cᵀG_f c. So the samples are visited once, and each candidate costs one
+  // solve of a leading block per fold. z is centred first so that Σz² does not swamp the error.
   static std::vector<int> CrossValidatedDegrees(const Eigen::Ref<const Eigen::VectorXd>& t,
                                                 const Eigen::Ref<const Eigen::MatrixXd>& z, int top,
                                                 const Interval& interval) {
@@ -184,34 +187,50 @@ class WindowFitter {
     }
     grid.push_back(top);
     const Eigen::Index m = t.size(), d = z.cols();
+    const Eigen::RowVectorXd mean = z.colwise().mean();
+    std::vector<NormalEquations> folds;
+    std::vector<Eigen::RowVectorXd> squares;
+    NormalEquations total;
+    for (int fold = 0; fold < kFolds; ++fold) {
+      const Eigen::Index count = (m - fold + kFolds - 1) / kFolds;
+      Eigen::VectorXd ft(count);
+      Eigen::MatrixXd fz(count, d);
+      for (Eigen::Index i = fold, k = 0; i < m; i += kFolds, ++k) {
+        ft[k] = t[i];
+        fz.row(k) = z.row(i) - mean;
+      }
+      // A fold may have fewer samples than top + 1: its own system is then singular, which is fine
+      // (only sums and products of it are used), so build it without the sample-count check.
+      NormalEquations normal = BuildNormalEquationsUnchecked(ft, fz, top, interval);
+      squares.push_back(fz.colwise().squaredNorm());
+      if (fold == 0) {
+        total = normal;
+      } else {
+        total.gram += normal.gram;
+        total.rhs += normal.rhs;
+        total.samples += normal.samples;
+      }
+      folds.push_back(std::move(normal));
+    }
     Eigen::MatrixXd error = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(grid.size()), d);
     for (int fold = 0; fold < kFolds; ++fold) {
-      const Eigen::Index test_count = (m - fold + kFolds - 1) / kFolds, train_count = m - test_count;
-      Eigen::VectorXd train_t(train_count), test_x(test_count);
-      Eigen::MatrixXd train_z(train_count, d), test_z(test_count, d);
-      for (Eigen::Index i = 0, a = 0, b = 0; i < m; ++i) {
-        if (i % kFolds == fold) {
-          test_x[b] = interval.ToUnit(t[i]);
-          test_z.row(b++) = z.row(i);
-        } else {
-          train_t[a] = t[i];
-          train_z.row(a++) = z.row(i);
-        }
-      }
-      const int fold_top = static_cast<int>(std::min<Eigen::Index>(top, train_count - 1));
-      const NormalEquations normal = BuildNormalEquations(train_t, train_z, fold_top, interval);
+      NormalEquations train = total;
+      train.gram -= folds[fold].gram;
+      train.rhs -= folds[fold].rhs;
+      train.samples -= folds[fold].samples;
       for (size_t g = 0; g < grid.size(); ++g) {
-        bool feasible = grid[g] <= fold_top;
-        if (feasible) {
-          try {
-            const ChebyshevSeries fit = SolveNormalEquations(normal, grid[g]);
-            error.row(static_cast<Eigen::Index>(g)) +=
-                (EvaluateSeries(fit.coefficients, test_x) - test_z).colwise().squaredNorm();
-          } catch (const ComputeError&) {
-            feasible = false;
+        const auto row = static_cast<Eigen::Index>(g);
+        const int n = grid[g] + 1;
+        try {
+          const Eigen::MatrixXd c = SolveNormalEquations(train, grid[g]).coefficients;  // n x d
+          const auto gram = folds[fold].gram.topLeftCorner(n, n);
+          const auto rhs = folds[fold].rhs.topRows(n);
+          for (Eigen::Index k = 0; k < d; ++k) {
+            error(row, k) += squares[fold][k] - 2.0 * c.col(k).dot(rhs.col(k)) + c.col(k).dot(gram * c.col(k));
           }
+        } catch (const ComputeError&) {
+          error.row(row).setConstant(std::numeric_limits<double>::infinity());
         }
-        if (!feasible) error.row(static_cast<Eigen::Index>(g)).setConstant(std::numeric_limits<double>::infinity());
       }
     }
     std::vector<int> degrees(static_cast<size_t>(d));

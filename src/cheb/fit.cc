@@ -112,6 +112,14 @@ NormalEquations BuildNormalEquations(const Eigen::Ref<const Eigen::VectorXd>& t,
   if (m < top + 1) {
     throw ComputeError(fmt::format("a degree-{} fit needs at least {} samples, got {}", top, top + 1, m));
   }
+  return BuildNormalEquationsUnchecked(t, z, top, interval, weights);
+}
+
+NormalEquations BuildNormalEquationsUnchecked(const Eigen::Ref<const Eigen::VectorXd>& t,
+                                              const Eigen::Ref<const Eigen::MatrixXd>& z, int top,
+                                              const Interval& interval, const Eigen::VectorXd* weights) {
+  const Eigen::Index m = t.size();
+  const int d = static_cast<int>(z.cols());
   Eigen::VectorXd x(m);
   for (Eigen::Index i = 0; i < m; ++i) x[i] = interval.ToUnit(t[i]);
   const Eigen::VectorXd w = weights != nullptr ? *weights : Eigen::VectorXd::Ones(m);

@@ -48,6 +48,12 @@ NormalEquations BuildNormalEquations(const Eigen::Ref<const Eigen::VectorXd>& t,
                                      const Eigen::Ref<const Eigen::MatrixXd>& z, int top, const Interval& interval,
                                      const Eigen::VectorXd* weights = nullptr);
 
+/// As BuildNormalEquations without the sample-count check: for sums of partial systems (e.g. the
+/// folds of a cross-validation), where each part alone may be singular.
+NormalEquations BuildNormalEquationsUnchecked(const Eigen::Ref<const Eigen::VectorXd>& t,
+                                              const Eigen::Ref<const Eigen::MatrixXd>& z, int top,
+                                              const Interval& interval, const Eigen::VectorXd* weights = nullptr);
+
 /// Solves the degree-N fit from normal equations built up to at least N. Throws ComputeError when
 /// the system is singular (LDLᵀ pivots spanning more than 1e13). If `gram_condition` is given it
 /// receives max/min of those pivots, an estimate of the normal matrix's condition number (the square
