@@ -392,6 +392,13 @@ class Reader {
         Fail(fields[layout.first_quaternion_field].column,
              fmt::format("quaternion ({}) has zero norm; expected a rotation", QuaternionNames(layout)));
       }
+      // Each value is finite, but n can still overflow (e.g. qx = 1e175); the rotation would silently
+      // become the identity (sqrt(2/n) = 0), so such a quaternion is no rotation either.
+      if (!std::isfinite(n)) {
+        Fail(fields[layout.first_quaternion_field].column,
+             fmt::format("quaternion ({}) is too large: its squared norm overflows a double; expected a rotation",
+                         QuaternionNames(layout)));
+      }
     }
     trajectory->Append(stamp, p, q, v, w);
   }
@@ -413,11 +420,20 @@ class Reader {
     for (size_t i = 0; i < 12; ++i) m[i] = Number(layout, fields, i);
     const double rotation[9] = {m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10]};
     const double position[3] = {m[3], m[7], m[11]};
-    const double det = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(rotation).determinant();
-    // A rotation has determinant 1; KITTI's are off by ~1e-6. 0.1 only rejects what is no rotation.
+    const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> R(rotation);
+    const double det = R.determinant();
+    // A rotation has determinant 1 and R·Rᵀ = I; KITTI's are off by ~1e-6. 0.1 only rejects what is
+    // no rotation (a determinant alone lets shears such as [1 1e160 0; 0 1 0; 0 0 1] through).
     if (!(std::abs(det - 1.0) <= 0.1)) {
       Fail(fields[0].column,
            fmt::format("expected a rotation matrix in fields 1-3, 5-7, 9-11 (r00..r22), got determinant {:.6g}", det));
+    }
+    const double orthonormality = (R * R.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+    if (!(orthonormality <= 0.1)) {
+      Fail(fields[0].column,
+           fmt::format("expected a rotation matrix in fields 1-3, 5-7, 9-11 (r00..r22), got one that is not "
+                       "orthonormal (max |R*R^T - I| = {:.6g})",
+                       orthonormality));
     }
     trajectory->Append(trajectory->size() * kNanosecondsPerSecond, position, rotation);
   }

@@ -77,7 +77,8 @@ Format DetectFormat(const std::string& path, std::string_view content);
 
 /// Reads a trajectory file. Throws InputError (`path:line:column: error: ...`) on any problem:
 /// missing or unreadable file, empty file, wrong field count, non-number, NaN/Inf, truncated last
-/// line, zero-norm quaternion, a non-rotation KITTI matrix, a KITTI times file of another length.
+/// line, zero-norm quaternion (or one whose squared norm overflows), a non-rotation KITTI matrix
+/// (determinant or R·Rᵀ off from 1 / I by more than 0.1), a KITTI times file of another length.
 /// If `format_read` is given, it receives the format used (the detected one for kAuto).
 Trajectory ReadTrajectory(const std::string& path, const ReadOptions& options = {}, Format* format_read = nullptr);
 
