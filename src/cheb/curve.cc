@@ -92,11 +92,12 @@ class WindowFitter {
     // window if allowed, else lower the degree until it is well posed.
     ChebyshevSeries high;
     Eigen::VectorXd variance_factors;
+    NormalEquations probe = BuildNormalEquations(tw, zw, top, interval);
     while (true) {
       double condition = std::numeric_limits<double>::infinity();
       try {
-        high = FitLeastSquares(tw, zw, top, interval, nullptr, &condition,
-                               options_.degree_method == DegreeMethod::kThreshold ? &variance_factors : nullptr);
+        high = SolveNormalEquations(probe, top, &condition,
+                                    options_.degree_method == DegreeMethod::kThreshold ? &variance_factors : nullptr);
       } catch (const ComputeError&) {
       }
       if (condition <= kMaxGramCondition) break;
@@ -106,7 +107,7 @@ class WindowFitter {
                                        "even a line",
                                        window.fit_begin, window.fit_end, m));
       }
-      top = std::max(1, static_cast<int>(0.7 * top));
+      top = std::max(1, static_cast<int>(0.7 * top));  // a leading block of the same normal equations
     }
     window.coefficient_magnitudes = high.coefficients.cwiseAbs();
     bool resolved = true;
@@ -151,7 +152,8 @@ class WindowFitter {
 
     // Each coordinate at its own degree, from one set of normal equations (leading blocks).
     const int degree = *std::max_element(window.degrees.begin(), window.degrees.end());
-    NormalEquations normal = BuildNormalEquations(tw, zw, degree, interval);
+    // The probe's normal equations hold every lower degree in their leading blocks.
+    NormalEquations& normal = probe;
     window.series.interval = interval;
     window.series.coefficients = Eigen::MatrixXd::Zero(degree + 1, d);
     const Eigen::MatrixXd rhs = normal.rhs;
@@ -336,12 +338,13 @@ void ClenshawInto(const Eigen::MatrixXd& coefficients, double x, double scale, P
   }
 }
 
-void EvaluateWindow(const CurveWindow& w, double t, Point* p, Point* v, Point* a) {
+// Value, and the derivatives up to `order` (0, 1 or 2), of a window at time t.
+void EvaluateWindow(const CurveWindow& w, double t, int order, Point* p, Point* v, Point* a) {
   const double x = w.series.interval.ToUnit(t);
   const double scale = w.series.interval.DerivativeScale();
   ClenshawInto(w.series.coefficients, x, 1.0, p);
-  ClenshawInto(w.first_derivative, x, scale, v);
-  ClenshawInto(w.second_derivative, x, scale * scale, a);
+  if (order >= 1) ClenshawInto(w.first_derivative, x, scale, v);
+  if (order >= 2) ClenshawInto(w.second_derivative, x, scale * scale, a);
 }
 
 }  // namespace
@@ -419,10 +422,10 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   }
 
   // Residuals at every sample.
-  Eigen::VectorXd p(values.cols()), v(values.cols()), a(values.cols());
+  Eigen::VectorXd p(values.cols());
   Eigen::VectorXd squares = Eigen::VectorXd::Zero(values.cols());
   for (Eigen::Index i = 0; i < m; ++i) {
-    curve.Evaluate(stamps_ns[order[i]], p, v, a);
+    curve.EvaluateValue(stamps_ns[order[i]], p);
     squares += (p - z.row(i).transpose()).cwiseAbs2();
   }
   curve.residual_rms_ = (squares / static_cast<double>(m)).cwiseSqrt();
@@ -431,6 +434,21 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
 
 void Curve::Evaluate(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value, Eigen::Ref<Eigen::VectorXd> derivative,
                      Eigen::Ref<Eigen::VectorXd> second_derivative, double tolerance_s) const {
+  EvaluateUpTo(stamp_ns, 2, value, &derivative, &second_derivative, tolerance_s);
+}
+
+void Curve::EvaluateValue(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value, double tolerance_s) const {
+  EvaluateUpTo(stamp_ns, 0, value, nullptr, nullptr, tolerance_s);
+}
+
+void Curve::EvaluateVelocity(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value, Eigen::Ref<Eigen::VectorXd> derivative,
+                             double tolerance_s) const {
+  EvaluateUpTo(stamp_ns, 1, value, &derivative, nullptr, tolerance_s);
+}
+
+void Curve::EvaluateUpTo(int64_t stamp_ns, int order, Eigen::Ref<Eigen::VectorXd> value,
+                         Eigen::Ref<Eigen::VectorXd>* derivative, Eigen::Ref<Eigen::VectorXd>* second_derivative,
+                         double tolerance_s) const {
   const double t = static_cast<double>(stamp_ns - origin_ns_) * 1e-9;
   // The segment containing t (or nearest within the tolerance).
   const CurveSegment* segment = nullptr;
@@ -450,7 +468,7 @@ void Curve::Evaluate(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value, Eigen:
                              [](double time, const CurveWindow& w) { return time < w.core_begin; });
   size_t k = it == windows.begin() ? 0 : static_cast<size_t>(it - windows.begin()) - 1;
   Point p, v, a;
-  EvaluateWindow(windows[k], t, &p, &v, &a);
+  EvaluateWindow(windows[k], t, order, &p, &v, &a);
   // Blend with the neighbour across the nearest core boundary when t is in the blending zone.
   auto blend = [&](size_t left, size_t right) {
     const double boundary = windows[right].core_begin;
@@ -458,21 +476,22 @@ void Curve::Evaluate(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value, Eigen:
     const double half = 0.5 * std::min(windows[left].fit_end - boundary, boundary - windows[right].fit_begin);
     if (!(half > 0.0) || t < boundary - half || t > boundary + half) return false;
     Point pl, vl, al, pr, vr, ar;
-    EvaluateWindow(windows[left], t, &pl, &vl, &al);
-    EvaluateWindow(windows[right], t, &pr, &vr, &ar);
+    // The blend's derivatives need the windows' values and lower derivatives.
+    EvaluateWindow(windows[left], t, order, &pl, &vl, &al);
+    EvaluateWindow(windows[right], t, order, &pr, &vr, &ar);
     double s, ds, dds;
     Smoothstep((t - (boundary - half)) / (2.0 * half), &s, &ds, &dds);
     ds /= 2.0 * half;
     dds /= 4.0 * half * half;
     p = (1.0 - s) * pl + s * pr;
-    v = (1.0 - s) * vl + s * vr + ds * (pr - pl);
-    a = (1.0 - s) * al + s * ar + 2.0 * ds * (vr - vl) + dds * (pr - pl);
+    if (order >= 1) v = (1.0 - s) * vl + s * vr + ds * (pr - pl);
+    if (order >= 2) a = (1.0 - s) * al + s * ar + 2.0 * ds * (vr - vl) + dds * (pr - pl);
     return true;
   };
   if (!(k > 0 && blend(k - 1, k)) && k + 1 < windows.size()) blend(k, k + 1);
   value = p;
-  derivative = v;
-  second_derivative = a;
+  if (order >= 1) *derivative = v;
+  if (order >= 2) *second_derivative = a;
 }
 
 Eigen::Index Curve::stored_values() const {

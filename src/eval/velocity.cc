@@ -104,9 +104,9 @@ VelocityEstimate EstimateVelocity(const traj::TrajectoryView& trajectory, const 
   cheb::Curve curve = cheb::FitCurve(trajectory.stamps_ns(), positions, options.curve);
   const std::span<const int64_t> query = at_ns ? *at_ns : trajectory.stamps_ns();
   estimate.velocities.resize(3, static_cast<Eigen::Index>(query.size()));
-  Eigen::VectorXd p(3), v(3), a(3);
+  Eigen::VectorXd p(3), v(3);
   for (size_t i = 0; i < query.size(); ++i) {
-    curve.Evaluate(query[i], p, v, a);
+    curve.EvaluateVelocity(query[i], p, v);
     estimate.velocities.col(static_cast<Eigen::Index>(i)) = v;
   }
   estimate.curve = std::move(curve);

@@ -93,6 +93,12 @@ class Curve {
   void Evaluate(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value, Eigen::Ref<Eigen::VectorXd> derivative,
                 Eigen::Ref<Eigen::VectorXd> second_derivative, double tolerance_s = 0.0) const;
 
+  /// Value only (cheaper), as Evaluate.
+  void EvaluateValue(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value, double tolerance_s = 0.0) const;
+  /// Value and first derivative, as Evaluate.
+  void EvaluateVelocity(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value, Eigen::Ref<Eigen::VectorXd> derivative,
+                        double tolerance_s = 0.0) const;
+
   int64_t origin_ns() const { return origin_ns_; }
   int dimension() const { return dimension_; }
   const std::vector<CurveSegment>& segments() const { return segments_; }
@@ -104,6 +110,9 @@ class Curve {
   Eigen::Index stored_values() const;
 
  private:
+  void EvaluateUpTo(int64_t stamp_ns, int order, Eigen::Ref<Eigen::VectorXd> value,
+                    Eigen::Ref<Eigen::VectorXd>* derivative, Eigen::Ref<Eigen::VectorXd>* second_derivative,
+                    double tolerance_s) const;
   friend Curve FitCurve(std::span<const int64_t>, const Eigen::Ref<const Eigen::MatrixXd>&, const CurveOptions&);
   int64_t origin_ns_ = 0;
   int dimension_ = 0;
