@@ -2,6 +2,8 @@
 // output file left behind when a command fails.
 #include <sys/wait.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -142,6 +144,75 @@ TEST_F(CliTest, UsageErrorsExitWith1) {
   EXPECT_EQ(Cheval("sim motion --duration -1 -o " + Path("x.txt")).exit_code, 1);
   EXPECT_FALSE(fs::exists(Path("x.txt")));
   EXPECT_EQ(Cheval("--help").exit_code, 0);
+}
+
+// Velocity RMSE (m/s) of a TUM + velocity file against the truth file, pose by pose.
+double VelocityRmse(const std::string& estimate, const std::string& truth) {
+  std::ifstream a(estimate), b(truth);
+  std::string la, lb;
+  double sum = 0;
+  int n = 0;
+  while (std::getline(a, la) && std::getline(b, lb)) {
+    std::istringstream sa(la), sb(lb);
+    double va[11], vb[11];
+    for (int k = 0; k < 11; ++k) sa >> va[k], sb >> vb[k];
+    for (int k = 8; k < 11; ++k) sum += (va[k] - vb[k]) * (va[k] - vb[k]);
+    ++n;
+  }
+  return n > 0 ? std::sqrt(sum / n) : 1e9;
+}
+
+TEST_F(CliTest, VelocityFromNoisyPositions) {
+  ASSERT_EQ(Cheval("sim motion --kind drone --duration 20 --noise 0.0005 -o " + Path("m.txt") + " --truth " +
+                   Path("t.txt"))
+                .exit_code,
+            0);
+  RunResult run = Cheval("velocity " + Path("m.txt") + " -o " + Path("v.txt") + " --json " + Path("v.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  RunResult central = Cheval("velocity " + Path("m.txt") + " --method central -o " + Path("c.txt"));
+  ASSERT_EQ(central.exit_code, 0) << central.err;
+  const double cheb = VelocityRmse(Path("v.txt"), Path("t.txt")), diff = VelocityRmse(Path("c.txt"), Path("t.txt"));
+  EXPECT_LT(cheb, 0.2 * diff) << cheb << " vs central " << diff;
+  const nlohmann::json j = nlohmann::json::parse(Slurp(Path("v.json")));
+  for (const char* key : {"method", "windows", "degrees", "noise_sigma_m", "residual_rmse_m", "compression_ratio",
+                          "seconds"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_NEAR(j["noise_sigma_m"][0].get<double>(), 0.0005, 0.0001);
+  EXPECT_GT(j["compression_ratio"].get<double>(), 10.0);
+  // --at: evaluate at other stamps (here every 10th measured stamp, from a stamps file).
+  std::ofstream at(Path("at.txt"));
+  std::ifstream measured(Path("m.txt"));
+  std::string line;
+  for (int i = 0; std::getline(measured, line); ++i) {
+    if (i % 10 == 5) at << line.substr(0, line.find(' ')) << "\n";
+  }
+  at.close();
+  RunResult at_run = Cheval("velocity " + Path("m.txt") + " --at " + Path("at.txt") + " -o " + Path("va.txt"));
+  ASSERT_EQ(at_run.exit_code, 0) << at_run.err;
+  const std::string evaluated = Slurp(Path("va.txt")), asked = Slurp(Path("at.txt"));
+  EXPECT_EQ(std::count(evaluated.begin(), evaluated.end(), '\n'), std::count(asked.begin(), asked.end(), '\n'));
+  EXPECT_EQ(evaluated.substr(0, 20), asked.substr(0, 20));  // the same stamps, in order
+}
+
+TEST_F(CliTest, VelocityBadInput) {
+  std::ofstream(Path("one.txt")) << "1 0 0 0 0 0 0 1\n";
+  RunResult one = Cheval("velocity " + Path("one.txt") + " -o " + Path("out.txt"));
+  EXPECT_EQ(one.exit_code, 3);
+  EXPECT_EQ(one.err, "cheval: error: a fit needs at least 2 samples, got 1\n");
+  std::ofstream(Path("same.txt")) << "1 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n1 2 0 0 0 0 0 1\n";
+  RunResult same = Cheval("velocity " + Path("same.txt") + " -o " + Path("out.txt"));
+  EXPECT_EQ(same.exit_code, 3);
+  EXPECT_EQ(same.err, "cheval: error: all 3 stamps are equal: there is no time to fit over\n");
+  ASSERT_EQ(Cheval("sim motion --duration 1 --rate 20 -o " + Path("short.txt")).exit_code, 0);
+  RunResult degree = Cheval("velocity " + Path("short.txt") + " --degree 50 -o " + Path("out.txt"));
+  EXPECT_EQ(degree.exit_code, 3);
+  EXPECT_NE(degree.err.find("degree 50 needs at least 51 distinct stamps per window"), std::string::npos);
+  EXPECT_EQ(Cheval("velocity " + Path("short.txt") + " --method magic").exit_code, 1);
+  EXPECT_EQ(Cheval("velocity " + Path("short.txt") + " --degree lots").exit_code, 1);
+  EXPECT_EQ(Cheval("velocity " + Path("short.txt") + " --method central --at " + Path("short.txt")).exit_code, 1);
+  EXPECT_EQ(Cheval("velocity " + cheval::testing::FixturePath("bad/nan.txt") + " -o " + Path("out.txt")).exit_code, 2);
+  EXPECT_FALSE(fs::exists(Path("out.txt")));
 }
 
 TEST_F(CliTest, InfoReadsSharedDataWithStatedCounts) {
