@@ -21,6 +21,8 @@
 #include "cheval/lie/sim3.h"
 #include "cheval/lie/so3.h"
 
+#include "lie_test_util.h"
+
 // Compile every member for float too (the typed tests use double, the Jet test uses ceres::Jet).
 template class cheval::lie::SO3<float>;
 template class cheval::lie::SE3<float>;
@@ -30,10 +32,10 @@ template class cheval::lie::SE23<float>;
 namespace cheval::lie {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using namespace ::cheval::lie::testing;
+
 // Fixed, and every sample list restarts from it, so a failure reproduces even under a test filter.
 constexpr unsigned kSeed = 20240611;
-constexpr int kRandomSamples = 100;
 
 // Tolerance of identities between group elements and tangents. Each side is a few dozen flops on
 // numbers of size ≤ 10 (translations up to 5 per axis, scales up to e²), so rounding leaves ~1e-14;
@@ -42,51 +44,10 @@ constexpr int kRandomSamples = 100;
 // tests at the end check those.)
 constexpr double kTol = 1e-12;
 
-double Uniform(std::mt19937& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
-
-Eigen::Vector3d RandomVector(std::mt19937& rng, double extent) {
-  return Eigen::Vector3d(Uniform(rng, -extent, extent), Uniform(rng, -extent, extent),
-                         Uniform(rng, -extent, extent));
-}
-
-Eigen::Vector3d RandomUnitVector(std::mt19937& rng) {
-  std::normal_distribution<double> normal;
-  return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
-}
-
 Eigen::Quaterniond RandomQuaternion(std::mt19937& rng) {
   std::normal_distribution<double> normal;  // normalised Gaussian 4-vector: uniform on SO(3)
   return Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized();
 }
-
-// An element of G with rotation r and its other parts random of size `extent`.
-template <typename G>
-G WithRotation(const SO3d& r, double extent, std::mt19937& rng);
-template <>
-SO3d WithRotation<SO3d>(const SO3d& r, double, std::mt19937&) {
-  return r;
-}
-template <>
-SE3d WithRotation<SE3d>(const SO3d& r, double extent, std::mt19937& rng) {
-  return SE3d(r, RandomVector(rng, extent));
-}
-template <>
-Sim3d WithRotation<Sim3d>(const SO3d& r, double extent, std::mt19937& rng) {
-  const double log_scale = std::min(extent, 1.0);
-  return Sim3d(r, RandomVector(rng, extent), std::exp(Uniform(rng, -log_scale, log_scale)));
-}
-template <>
-SE23d WithRotation<SE23d>(const SO3d& r, double extent, std::mt19937& rng) {
-  return SE23d(r, RandomVector(rng, extent), RandomVector(rng, extent));
-}
-
-template <typename T>
-struct Sample {
-  std::string name;
-  T value;
-};
 
 // identity, tiny, tiny rotation with O(1) rest, within 1e-6 of π, exactly π (w = 0), random.
 template <typename G>
@@ -109,29 +70,10 @@ std::vector<Sample<G>> ElementSamples() {
   return s;
 }
 
-// A tangent with rotation angle `angle` about a random axis and other components in ±extent.
-template <typename G>
-typename G::Tangent TangentWithAngle(double angle, double extent, std::mt19937& rng) {
-  typename G::Tangent tau;
-  tau.template head<3>() = angle * RandomUnitVector(rng);
-  for (int i = 3; i < G::kDoF; ++i) tau[i] = Uniform(rng, -extent, extent);
-  return tau;
-}
-
 // Tangents with |ω| < π (where Log(Exp(τ)) = τ holds).
 template <typename G>
 std::vector<Sample<typename G::Tangent>> TangentSamples() {
-  std::mt19937 rng(kSeed + 1);
-  std::vector<Sample<typename G::Tangent>> s;
-  s.push_back({"zero", G::Tangent::Zero()});
-  s.push_back({"tiny", TangentWithAngle<G>(1e-8, 1e-8, rng)});
-  s.push_back({"tiny rotation", TangentWithAngle<G>(1e-8, 2.0, rng)});
-  s.push_back({"pi - 1e-6", TangentWithAngle<G>(kPi - 1e-6, 2.0, rng)});
-  for (int i = 0; i < kRandomSamples; ++i) {
-    s.push_back({"random " + std::to_string(i),
-                 TangentWithAngle<G>(Uniform(rng, 0.0, kPi - 1e-6), 2.0, rng)});
-  }
-  return s;
+  return MakeTangentSamples<G>(kSeed + 1, TangentWithAngle<G>);
 }
 
 // ‖a − b‖_F ≤ tol · max(1, ‖b‖_F): for group matrices, whose rotation block has norm √3.
@@ -164,17 +106,9 @@ Eigen::Matrix<double, G::kMatrixDim, 1> HomogeneousPoint(const Eigen::Vector3d& 
   return h;
 }
 
-struct GroupName {
-  template <typename G>
-  static std::string GetName(int) {
-    return std::string(G::kName);
-  }
-};
-
 template <typename G>
 class LieGroupTest : public ::testing::Test {};
 
-using Groups = ::testing::Types<SO3d, SE3d, Sim3d, SE23d>;
 TYPED_TEST_SUITE(LieGroupTest, Groups, GroupName);
 
 TYPED_TEST(LieGroupTest, IdentityIsIdentityMatrixWithZeroLog) {

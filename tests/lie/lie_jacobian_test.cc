@@ -19,12 +19,14 @@
 #include "cheval/lie/sim3.h"
 #include "cheval/lie/so3.h"
 
+#include "lie_test_util.h"
+
 namespace cheval::lie {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using namespace ::cheval::lie::testing;
+
 constexpr unsigned kSeed = 20240612;  // fixed, and every sample list restarts from it
-constexpr int kRandomSamples = 100;
 
 // Central differences with step h have truncation error h²/6 · |f'''| and rounding error ε|f|/h;
 // with h = 1e-5 and |f|, |f'''| ≤ ~10 on these samples both are ~1e-10 (the largest error observed
@@ -36,40 +38,7 @@ constexpr double kStep = 1e-5;
 constexpr double kTol = 1e-7;
 
 template <typename T>
-concept Group = requires(const T& g) {
-  g.Log();
-  g.Inverse();
-};
-
-template <typename T>
-constexpr int Dim() {
-  if constexpr (Group<T>) {
-    return T::kDoF;
-  } else {
-    return T::RowsAtCompileTime;
-  }
-}
-
-template <typename T>
 using Delta = Eigen::Matrix<double, Dim<T>(), 1>;
-
-template <typename T>
-T Perturb(const T& x, const Delta<T>& d) {
-  if constexpr (Group<T>) {
-    return x.Plus(d);
-  } else {
-    return x + d;
-  }
-}
-
-template <typename T>
-Delta<T> Difference(const T& a, const T& b) {
-  if constexpr (Group<T>) {
-    return a.Minus(b);
-  } else {
-    return a - b;
-  }
-}
 
 // ∂(f(x ⊕ δ) ⊖ f(x))/∂δ at δ = 0 by central differences.
 template <typename In, typename F>
@@ -89,58 +58,17 @@ auto NumericalJacobian(const F& f, const In& x) {
 
 template <typename A, typename B>
 ::testing::AssertionResult JacobianNear(const A& analytic, const B& numeric, double tol = kTol) {
-  const double error = (analytic - numeric).cwiseAbs().maxCoeff();
-  const double scale = std::max(1.0, numeric.cwiseAbs().maxCoeff());
-  if (error <= tol * scale) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure()
-         << "max error " << error << " > " << tol << " · " << scale << "\nanalytic:\n"
-         << analytic << "\nnumeric:\n"
-         << numeric;
+  return MaxEntryNear(analytic, numeric, tol, "numeric");
 }
-
-double Uniform(std::mt19937& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
-
-Eigen::Vector3d RandomVector(std::mt19937& rng, double extent) {
-  return Eigen::Vector3d(Uniform(rng, -extent, extent), Uniform(rng, -extent, extent),
-                         Uniform(rng, -extent, extent));
-}
-
-Eigen::Vector3d RandomUnitVector(std::mt19937& rng) {
-  std::normal_distribution<double> normal;
-  return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
-}
-
-template <typename G>
-typename G::Tangent TangentWithAngle(double angle, double extent, std::mt19937& rng) {
-  typename G::Tangent tau;
-  tau.template head<3>() = angle * RandomUnitVector(rng);
-  for (int i = 3; i < G::kDoF; ++i) tau[i] = Uniform(rng, -extent, extent);
-  return tau;
-}
-
-template <typename T>
-struct Sample {
-  std::string name;
-  T value;
-};
 
 // Tangents (for Exp and Plus): |ω| < π, ρ in ±2, log-scale σ in ±1 (±2 for "tiny rotation").
 template <typename G>
 std::vector<Sample<typename G::Tangent>> TangentSamples() {
-  std::mt19937 rng(kSeed);
-  std::vector<Sample<typename G::Tangent>> s;
-  s.push_back({"zero", G::Tangent::Zero()});
-  s.push_back({"tiny", TangentWithAngle<G>(1e-8, 1e-8, rng)});
-  s.push_back({"tiny rotation", TangentWithAngle<G>(1e-8, 2.0, rng)});
-  s.push_back({"pi - 1e-6", TangentWithAngle<G>(kPi - 1e-6, 2.0, rng)});
-  for (int i = 0; i < kRandomSamples; ++i) {
-    typename G::Tangent tau = TangentWithAngle<G>(Uniform(rng, 0.0, kPi - 1e-6), 2.0, rng);
+  // The random ones then redraw σ in ±1 (one more draw each).
+  const auto redraw_sigma = [](typename G::Tangent& tau, std::mt19937& rng) {
     if constexpr (G::kDoF == 7) tau[6] = Uniform(rng, -1.0, 1.0);
-    s.push_back({"random " + std::to_string(i), tau});
-  }
-  return s;
+  };
+  return MakeTangentSamples<G>(kSeed, TangentWithAngle<G>, redraw_sigma);
 }
 
 // Elements: Exp of the tangent samples plus exactly π. For Log, whose finite differences must not
@@ -165,17 +93,9 @@ std::vector<Element<G>> ElementSamples() {
   return s;
 }
 
-struct GroupName {
-  template <typename G>
-  static std::string GetName(int) {
-    return std::string(G::kName);
-  }
-};
-
 template <typename G>
 class LieJacobianTest : public ::testing::Test {};
 
-using Groups = ::testing::Types<SO3d, SE3d, Sim3d, SE23d>;
 TYPED_TEST_SUITE(LieJacobianTest, Groups, GroupName);
 
 TYPED_TEST(LieJacobianTest, Exp) {

@@ -23,6 +23,8 @@
 #include "cheval/lie/sim3.h"
 #include "cheval/lie/so3.h"
 
+#include "lie_test_util.h"
+
 // Every member function of every group, Jacobian outputs included, compiles with Jets.
 template class cheval::lie::SO3<ceres::Jet<double, 3>>;
 template class cheval::lie::SE3<ceres::Jet<double, 6>>;
@@ -32,30 +34,15 @@ template class cheval::lie::SE23<ceres::Jet<double, 9>>;
 namespace cheval::lie {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using namespace ::cheval::lie::testing;
+
 constexpr unsigned kSeed = 20240613;  // fixed, and every sample list restarts from it
-constexpr int kRandomSamples = 100;
 
 // Jets and the closed forms compute the same derivative along different roundings: chain rules
 // through sin/cos/atan2/sqrt versus Jacobian formulas. Entries are ≤ ~30 and each side is a few
 // hundred flops, so agreement is ~1e-14 relative; 1e-12 (relative to max(1, largest entry))
 // leaves a margin of 100 and is 1e5 tighter than the finite-difference check.
 constexpr double kTol = 1e-12;
-
-template <typename T>
-concept Group = requires(const T& g) {
-  g.Log();
-  g.Inverse();
-};
-
-template <typename T>
-constexpr int Dim() {
-  if constexpr (Group<T>) {
-    return T::kDoF;
-  } else {
-    return T::RowsAtCompileTime;
-  }
-}
 
 // G<double> → G<S>.
 template <typename G, typename S>
@@ -74,26 +61,6 @@ auto ToJet(const T& x) {
     return x.template Cast<J>();
   } else {
     return x.template cast<J>().eval();
-  }
-}
-
-// x ⊕ δ for groups (right Plus), x + δ for vectors.
-template <typename T, typename D>
-T Perturb(const T& x, const D& d) {
-  if constexpr (Group<T>) {
-    return x.Plus(d);
-  } else {
-    return (x + d).eval();
-  }
-}
-
-// a ⊖ b for groups (right Minus), a − b for vectors.
-template <typename T>
-auto Difference(const T& a, const T& b) {
-  if constexpr (Group<T>) {
-    return a.Minus(b);
-  } else {
-    return (a - b).eval();
   }
 }
 
@@ -118,77 +85,17 @@ auto AutoDiffJacobian(const F& f, const In& x) {
 
 template <typename A, typename B>
 ::testing::AssertionResult JacobianNear(const A& analytic, const B& autodiff) {
-  const double error = (analytic - autodiff).cwiseAbs().maxCoeff();
-  const double scale = std::max(1.0, autodiff.cwiseAbs().maxCoeff());
-  if (error <= kTol * scale) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure()
-         << "max error " << error << " > " << kTol << " · " << scale << "\nanalytic:\n"
-         << analytic << "\nautodiff:\n"
-         << autodiff;
+  return MaxEntryNear(analytic, autodiff, kTol, "autodiff");
 }
-
-double Uniform(std::mt19937& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
-
-Eigen::Vector3d RandomVector(std::mt19937& rng, double extent) {
-  return Eigen::Vector3d(Uniform(rng, -extent, extent), Uniform(rng, -extent, extent),
-                         Uniform(rng, -extent, extent));
-}
-
-Eigen::Vector3d RandomUnitVector(std::mt19937& rng) {
-  std::normal_distribution<double> normal;
-  return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
-}
-
-template <typename G>
-typename G::Tangent TangentWithAngle(double angle, double extent, std::mt19937& rng) {
-  typename G::Tangent tau;
-  tau.template head<3>() = angle * RandomUnitVector(rng);
-  for (int i = 3; i < G::kDoF; ++i) tau[i] = Uniform(rng, -extent, extent);
-  if constexpr (G::kDoF == 7) tau[6] /= std::max(extent, 1.0);  // log-scale within ±1
-  return tau;
-}
-
-template <typename T>
-struct Sample {
-  std::string name;
-  T value;
-};
 
 template <typename G>
 std::vector<Sample<typename G::Tangent>> TangentSamples() {
-  std::mt19937 rng(kSeed);
-  std::vector<Sample<typename G::Tangent>> s;
-  s.push_back({"zero", G::Tangent::Zero()});
-  s.push_back({"tiny", TangentWithAngle<G>(1e-8, 1e-8, rng)});
-  s.push_back({"tiny rotation", TangentWithAngle<G>(1e-8, 2.0, rng)});
-  s.push_back({"pi - 1e-6", TangentWithAngle<G>(kPi - 1e-6, 2.0, rng)});
-  for (int i = 0; i < kRandomSamples; ++i) {
-    s.push_back({"random " + std::to_string(i),
-                 TangentWithAngle<G>(Uniform(rng, 0.0, kPi - 1e-6), 2.0, rng)});
-  }
-  return s;
-}
-
-// An element of G with rotation r and its other parts random in ±2 (log-scale ±1).
-template <typename G>
-G WithRotation(const SO3d& r, std::mt19937& rng);
-template <>
-SO3d WithRotation<SO3d>(const SO3d& r, std::mt19937&) {
-  return r;
-}
-template <>
-SE3d WithRotation<SE3d>(const SO3d& r, std::mt19937& rng) {
-  return SE3d(r, RandomVector(rng, 2.0));
-}
-template <>
-Sim3d WithRotation<Sim3d>(const SO3d& r, std::mt19937& rng) {
-  return Sim3d(r, RandomVector(rng, 2.0), std::exp(Uniform(rng, -1.0, 1.0)));
-}
-template <>
-SE23d WithRotation<SE23d>(const SO3d& r, std::mt19937& rng) {
-  return SE23d(r, RandomVector(rng, 2.0), RandomVector(rng, 2.0));
+  const auto draw = [](double angle, double extent, std::mt19937& rng) {
+    typename G::Tangent tau = TangentWithAngle<G>(angle, extent, rng);
+    if constexpr (G::kDoF == 7) tau[6] /= std::max(extent, 1.0);  // log-scale within ±1
+    return tau;
+  };
+  return MakeTangentSamples<G>(kSeed, draw);
 }
 
 // Exp of the tangent samples, plus an element whose quaternion is (0, u): θ = π exactly, where Log
@@ -199,21 +106,15 @@ std::vector<Sample<G>> ElementSamples() {
   for (const auto& [name, tau] : TangentSamples<G>()) s.push_back({name, G::Exp(tau)});
   std::mt19937 rng(kSeed + 1);
   const Eigen::Vector3d u = RandomUnitVector(rng);
-  s.push_back({"pi", WithRotation<G>(SO3d(Eigen::Quaterniond(0.0, u.x(), u.y(), u.z())), rng)});
+  // Other parts random in ±2 (log-scale ±1).
+  s.push_back(
+      {"pi", WithRotation<G>(SO3d(Eigen::Quaterniond(0.0, u.x(), u.y(), u.z())), 2.0, rng)});
   return s;
 }
-
-struct GroupName {
-  template <typename G>
-  static std::string GetName(int) {
-    return std::string(G::kName);
-  }
-};
 
 template <typename G>
 class LieJetTest : public ::testing::Test {};
 
-using Groups = ::testing::Types<SO3d, SE3d, Sim3d, SE23d>;
 TYPED_TEST_SUITE(LieJetTest, Groups, GroupName);
 
 TYPED_TEST(LieJetTest, Exp) {
