@@ -73,9 +73,9 @@ ColumnMap ColumnMap::Parse(std::string_view spec) {
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
-  auto count = [&](std::initializer_list<ColumnRole> roles) {
+  auto count = [&](std::initializer_list<ColumnRole> wanted) {
     int n = 0;
-    for (ColumnRole r : roles) n += seen.count(r) ? 1 : 0;
+    for (ColumnRole r : wanted) n += seen.count(r) ? 1 : 0;
     return n;
   };
   const int times = count({ColumnRole::kTimeSeconds, ColumnRole::kTimeMilliseconds, ColumnRole::kTimeMicroseconds,
