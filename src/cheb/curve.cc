@@ -1,6 +1,7 @@
 #include "cheval/cheb/curve.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -88,17 +89,28 @@ class WindowFitter {
     int top = static_cast<int>(std::min<double>(
         {static_cast<double>(options_.max_degree), std::floor(std::sqrt(options_.max_conditioning * m)),
          static_cast<double>(distinct - 1)}));
+    // Cross-validation needs the normal equations of each fold; their sum is the whole window's,
+    // so the samples are visited once either way.
+    const bool cross_validate = options_.degree_method == DegreeMethod::kCrossValidation;
+    std::optional<Folds> folds;
+    NormalEquations probe;
+    if (cross_validate) {
+      folds = BuildFolds(tw, zw, top, interval);
+      probe = folds->Uncentred();
+    } else {
+      probe = BuildNormalEquations(tw, zw, top, interval);
+    }
     // The probe fit at the top degree; uneven sampling can make it ill-conditioned: then split the
-    // window if allowed, else lower the degree until it is well posed.
-    ChebyshevSeries high;
-    Eigen::VectorXd variance_factors;
-    NormalEquations probe = BuildNormalEquations(tw, zw, top, interval);
+    // window if allowed, else lower the degree until it is well posed. One factorisation serves
+    // every degree up to top (leading blocks).
+    std::optional<NestedCholesky> cholesky;
     while (true) {
       double condition = std::numeric_limits<double>::infinity();
       try {
-        high = SolveNormalEquations(probe, top, &condition,
-                                    options_.degree_method == DegreeMethod::kThreshold ? &variance_factors : nullptr);
+        cholesky.emplace(probe, top);
+        condition = cholesky->Condition(top);
       } catch (const ComputeError&) {
+        cholesky.reset();
       }
       if (condition <= kMaxGramCondition) break;
       if (may_split) return std::nullopt;
@@ -109,15 +121,17 @@ class WindowFitter {
       }
       top = std::max(1, static_cast<int>(0.7 * top));  // a leading block of the same normal equations
     }
-    window.coefficient_magnitudes = high.coefficients.cwiseAbs();
+    const Eigen::MatrixXd high = cholesky->Solve(top, probe.rhs);
+    window.coefficient_magnitudes = high.cwiseAbs();
     bool resolved = true;
     if (options_.degree_method == DegreeMethod::kThreshold) {
+      const Eigen::VectorXd variance_factors = cholesky->VarianceFactors(top);
       const double universal = std::sqrt(2.0 * std::log(static_cast<double>(top + 1)));
       for (int c = 0; c < d; ++c) {
         int significant = 0;
         for (int k = 1; k <= top; ++k) {
           const double threshold = universal * sigma_[c] * std::sqrt(variance_factors[k]);
-          if (std::abs(high.coefficients(k, c)) > threshold) significant = k;
+          if (std::abs(high(k, c)) > threshold) significant = k;
         }
         window.degrees[c] = significant;
         // Significant coefficients up to the top: the motion is not resolved at this degree.
@@ -128,110 +142,144 @@ class WindowFitter {
       // noise plateau); it also picks the degree for kChop. Cross-validation picks the degree of a
       // resolved window for kCrossValidation: held-out error alone cannot tell an unresolved window
       // (every candidate underfits) from a resolved one.
-      for (int c = 0; c < d; ++c) {
-        // The mean (c_0) says nothing about how well the motion is resolved, and a large offset
-        // (positions far from the origin) would make every other coefficient look negligible:
-        // the chop sees the series relative to the largest varying coefficient.
-        Eigen::VectorXd coefficients = high.coefficients.col(c);
-        coefficients[0] = top >= 1 ? coefficients.tail(top).cwiseAbs().maxCoeff() : 0.0;
-        const double scale = coefficients.cwiseAbs().maxCoeff();
-        if (scale == 0.0) continue;  // a constant coordinate: degree 0
-        // Noise level of a coefficient of m equispaced samples: σ·sqrt(2/m) (CHEBYSHEV.md).
-        const double noise = sigma_[c] * std::sqrt(2.0 / static_cast<double>(m));
-        const double tol = std::clamp(noise / scale, kRoundingTolerance, 0.5);
-        const int keep = StandardChop(coefficients, tol);
-        // StandardChop needs 17 coefficients; below that, or without a plateau, it keeps all.
-        if (keep == top + 1) resolved = false;
-        window.degrees[c] = keep - 1;
-      }
-      if (options_.degree_method == DegreeMethod::kCrossValidation && (resolved || !may_split)) {
-        window.degrees = CrossValidatedDegrees(tw, zw, top, interval);
-      }
+      resolved = ChopDegrees(high, m, &window.degrees);
+      if (cross_validate && (resolved || !may_split)) window.degrees = CrossValidatedDegrees(*folds, top);
     }
     if (!resolved && may_split) return std::nullopt;
 
-    // Each coordinate at its own degree, from one set of normal equations (leading blocks).
+    // Each coordinate at its own degree: leading blocks of the same factorisation.
     const int degree = *std::max_element(window.degrees.begin(), window.degrees.end());
-    // The probe's normal equations hold every lower degree in their leading blocks.
-    NormalEquations& normal = probe;
     window.series.interval = interval;
     window.series.coefficients = Eigen::MatrixXd::Zero(degree + 1, d);
-    const Eigen::MatrixXd rhs = normal.rhs;
     for (int c = 0; c < d; ++c) {
-      normal.rhs = rhs.col(c);
-      const ChebyshevSeries axis = SolveNormalEquations(normal, window.degrees[c]);
-      window.series.coefficients.col(c).head(window.degrees[c] + 1) = axis.coefficients.col(0);
+      window.series.coefficients.col(c).head(window.degrees[c] + 1) =
+          cholesky->Solve(window.degrees[c], probe.rhs.col(c));
     }
     Finish(&window);
     return window;
   }
 
- private:
+  // Derivative coefficients of a fitted window.
   static void Finish(CurveWindow* window) {
     window->first_derivative = DerivativeCoefficients(window->series.coefficients);
     window->second_derivative = DerivativeCoefficients(window->first_derivative);
   }
 
-  // 5-fold cross-validation (folds interleaved: sample i in fold i mod 5) over a geometric grid
-  // of degrees up to `top`, per coordinate: the degree of least held-out squared error.
-  // Nothing is evaluated point by point: with F_f the normal equations (G_f, b_f) and Σz² of fold
-  // f, the training system of fold f is Σ F - F_f, and the held-out error of coefficients c is
-  // Σz²_f - 2 cᵀb_f + cᵀG_f c. So the samples are visited once, and each candidate costs one
-  // solve of a leading block per fold. z is centred first so that Σz² does not swamp the error.
-  static std::vector<int> CrossValidatedDegrees(const Eigen::Ref<const Eigen::VectorXd>& t,
-                                                const Eigen::Ref<const Eigen::MatrixXd>& z, int top,
-                                                const Interval& interval) {
-    constexpr int kFolds = 5;
-    std::vector<int> grid;
-    for (double g = 2; g < top; g *= 1.25) {
-      const int degree = static_cast<int>(std::lround(g));
-      if (grid.empty() || degree != grid.back()) grid.push_back(degree);
+ private:
+  // standardChop on each coordinate of a probe fit `high` ((top + 1) x d) of m samples: the degree
+  // it keeps per coordinate, and whether every coordinate reached its noise plateau (resolved).
+  bool ChopDegrees(const Eigen::MatrixXd& high, Eigen::Index m, std::vector<int>* degrees) const {
+    const int top = static_cast<int>(high.rows()) - 1;
+    bool resolved = true;
+    for (Eigen::Index c = 0; c < high.cols(); ++c) {
+      // The mean (c_0) says nothing about how well the motion is resolved, and a large offset
+      // (positions far from the origin) would make every other coefficient look negligible:
+      // the chop sees the series relative to the largest varying coefficient.
+      Eigen::VectorXd coefficients = high.col(c);
+      coefficients[0] = top >= 1 ? coefficients.tail(top).cwiseAbs().maxCoeff() : 0.0;
+      const double scale = coefficients.cwiseAbs().maxCoeff();
+      (*degrees)[c] = 0;
+      if (scale == 0.0) continue;  // a constant coordinate: degree 0
+      // Noise level of a coefficient of m equispaced samples: σ·sqrt(2/m) (CHEBYSHEV.md).
+      const double noise = sigma_[c] * std::sqrt(2.0 / static_cast<double>(m));
+      const double tol = std::clamp(noise / scale, kRoundingTolerance, 0.5);
+      const int keep = StandardChop(coefficients, tol);
+      // StandardChop needs 17 coefficients; below that, or without a plateau, it keeps all.
+      if (keep == top + 1) resolved = false;
+      (*degrees)[c] = keep - 1;
     }
-    grid.push_back(top);
-    const Eigen::Index m = t.size(), d = z.cols();
-    const Eigen::RowVectorXd mean = z.colwise().mean();
-    std::vector<NormalEquations> folds;
+    return resolved;
+  }
+
+  // The normal equations of each cross-validation fold (sample i in fold i mod kFolds) of the
+  // samples centred on their mean, with Σz² per fold, and their sum.
+  static constexpr int kFolds = 5;
+  struct Folds {
+    std::vector<NormalEquations> parts;
     std::vector<Eigen::RowVectorXd> squares;
     NormalEquations total;
+    Eigen::RowVectorXd mean;
+
+    // The normal equations of the samples themselves: Σ T_k(x_i)(z_i - z̄) + z̄·Σ T_k(x_i), and
+    // Σ T_k(x_i) = Σ T_k(x_i)T_0(x_i) is column 0 of the normal matrix.
+    NormalEquations Uncentred() const {
+      NormalEquations normal = total;
+      normal.rhs += normal.gram.col(0) * mean;
+      return normal;
+    }
+  };
+
+  static Folds BuildFolds(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
+                          int top, const Interval& interval) {
+    const Eigen::Index m = t.size(), d = z.cols();
+    Folds folds;
+    folds.mean = z.colwise().mean();
     for (int fold = 0; fold < kFolds; ++fold) {
       const Eigen::Index count = (m - fold + kFolds - 1) / kFolds;
       Eigen::VectorXd ft(count);
       Eigen::MatrixXd fz(count, d);
       for (Eigen::Index i = fold, k = 0; i < m; i += kFolds, ++k) {
         ft[k] = t[i];
-        fz.row(k) = z.row(i) - mean;
+        fz.row(k) = z.row(i) - folds.mean;
       }
       // A fold may have fewer samples than top + 1: its own system is then singular, which is fine
       // (only sums and products of it are used), so build it without the sample-count check.
       NormalEquations normal = BuildNormalEquationsUnchecked(ft, fz, top, interval);
-      squares.push_back(fz.colwise().squaredNorm());
+      folds.squares.push_back(fz.colwise().squaredNorm());
       if (fold == 0) {
-        total = normal;
+        folds.total = normal;
       } else {
-        total.gram += normal.gram;
-        total.rhs += normal.rhs;
-        total.samples += normal.samples;
+        folds.total.gram += normal.gram;
+        folds.total.rhs += normal.rhs;
+        folds.total.samples += normal.samples;
       }
-      folds.push_back(std::move(normal));
+      folds.parts.push_back(std::move(normal));
     }
+    return folds;
+  }
+
+  // 5-fold cross-validation over a geometric grid of degrees up to `top`, per coordinate: the
+  // degree of least held-out squared error. Nothing is evaluated point by point: with F_f the
+  // normal equations (G_f, b_f) and Σz² of fold f, the training system of fold f is Σ F - F_f,
+  // and the held-out error of coefficients c is Σz²_f - 2 cᵀb_f + cᵀG_f c. Each fold's training
+  // system is factorised once; each candidate degree is then two triangular solves of a leading
+  // block.
+  static std::vector<int> CrossValidatedDegrees(const Folds& folds, int top) {
+    std::vector<int> grid;
+    for (double g = 2; g < top; g *= 1.25) {
+      const int degree = static_cast<int>(std::lround(g));
+      if (grid.empty() || degree != grid.back()) grid.push_back(degree);
+    }
+    grid.push_back(top);
+    const Eigen::Index d = folds.total.rhs.cols();
     Eigen::MatrixXd error = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(grid.size()), d);
     for (int fold = 0; fold < kFolds; ++fold) {
-      NormalEquations train = total;
-      train.gram -= folds[fold].gram;
-      train.rhs -= folds[fold].rhs;
-      train.samples -= folds[fold].samples;
+      const NormalEquations& held_out = folds.parts[fold];
+      NormalEquations train = folds.total;
+      train.gram -= held_out.gram;
+      train.rhs -= held_out.rhs;
+      train.samples -= held_out.samples;
+      // The training system may be singular above some degree: candidates above it score +inf.
+      int solvable = top;
+      std::optional<NestedCholesky> cholesky;
+      while (!cholesky && solvable >= 0) {
+        try {
+          cholesky.emplace(train, solvable);
+        } catch (const ComputeError&) {
+          solvable = solvable > 8 ? static_cast<int>(0.8 * solvable) : solvable - 1;
+        }
+      }
       for (size_t g = 0; g < grid.size(); ++g) {
         const auto row = static_cast<Eigen::Index>(g);
-        const int n = grid[g] + 1;
-        try {
-          const Eigen::MatrixXd c = SolveNormalEquations(train, grid[g]).coefficients;  // n x d
-          const auto gram = folds[fold].gram.topLeftCorner(n, n);
-          const auto rhs = folds[fold].rhs.topRows(n);
-          for (Eigen::Index k = 0; k < d; ++k) {
-            error(row, k) += squares[fold][k] - 2.0 * c.col(k).dot(rhs.col(k)) + c.col(k).dot(gram * c.col(k));
-          }
-        } catch (const ComputeError&) {
+        if (!cholesky || grid[g] > solvable) {
           error.row(row).setConstant(std::numeric_limits<double>::infinity());
+          continue;
+        }
+        const int n = grid[g] + 1;
+        const Eigen::MatrixXd c = cholesky->Solve(grid[g], train.rhs);  // n x d
+        const Eigen::MatrixXd gc = held_out.gram.topLeftCorner(n, n).selfadjointView<Eigen::Lower>() * c;
+        for (Eigen::Index k = 0; k < d; ++k) {
+          error(row, k) += folds.squares[fold][k] - 2.0 * c.col(k).dot(held_out.rhs.col(k).head(n)) + c.col(k).dot(gc.col(k));
         }
       }
     }
@@ -422,12 +470,9 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   }
 
   // Residuals at every sample.
-  Eigen::VectorXd p(values.cols());
-  Eigen::VectorXd squares = Eigen::VectorXd::Zero(values.cols());
-  for (Eigen::Index i = 0; i < m; ++i) {
-    curve.EvaluateValue(stamps_ns[order[i]], p);
-    squares += (p - z.row(i).transpose()).cwiseAbs2();
-  }
+  Eigen::MatrixXd fitted;
+  curve.EvaluateMany(stamps_ns, 0, &fitted);
+  const Eigen::VectorXd squares = (fitted - values).colwise().squaredNorm().transpose();
   curve.residual_rms_ = (squares / static_cast<double>(m)).cwiseSqrt();
   return curve;
 }
@@ -446,10 +491,7 @@ void Curve::EvaluateVelocity(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value
   EvaluateUpTo(stamp_ns, 1, value, &derivative, nullptr, tolerance_s);
 }
 
-void Curve::EvaluateUpTo(int64_t stamp_ns, int order, Eigen::Ref<Eigen::VectorXd> value,
-                         Eigen::Ref<Eigen::VectorXd>* derivative, Eigen::Ref<Eigen::VectorXd>* second_derivative,
-                         double tolerance_s) const {
-  const double t = static_cast<double>(stamp_ns - origin_ns_) * 1e-9;
+Curve::Placement Curve::Locate(double t, double tolerance_s) const {
   // The segment containing t (or nearest within the tolerance).
   const CurveSegment* segment = nullptr;
   for (const CurveSegment& s : segments_) {
@@ -466,32 +508,146 @@ void Curve::EvaluateUpTo(int64_t stamp_ns, int order, Eigen::Ref<Eigen::VectorXd
   // The window whose core holds t.
   auto it = std::upper_bound(windows.begin(), windows.end(), t,
                              [](double time, const CurveWindow& w) { return time < w.core_begin; });
-  size_t k = it == windows.begin() ? 0 : static_cast<size_t>(it - windows.begin()) - 1;
-  Point p, v, a;
-  EvaluateWindow(windows[k], t, order, &p, &v, &a);
+  const size_t k = it == windows.begin() ? 0 : static_cast<size_t>(it - windows.begin()) - 1;
+  Placement placement;
+  placement.left = &windows[k];
   // Blend with the neighbour across the nearest core boundary when t is in the blending zone.
   auto blend = [&](size_t left, size_t right) {
     const double boundary = windows[right].core_begin;
     // Half the overlap both windows have across the boundary: each is then well inside its data.
     const double half = 0.5 * std::min(windows[left].fit_end - boundary, boundary - windows[right].fit_begin);
     if (!(half > 0.0) || t < boundary - half || t > boundary + half) return false;
-    Point pl, vl, al, pr, vr, ar;
-    // The blend's derivatives need the windows' values and lower derivatives.
-    EvaluateWindow(windows[left], t, order, &pl, &vl, &al);
-    EvaluateWindow(windows[right], t, order, &pr, &vr, &ar);
-    double s, ds, dds;
-    Smoothstep((t - (boundary - half)) / (2.0 * half), &s, &ds, &dds);
-    ds /= 2.0 * half;
-    dds /= 4.0 * half * half;
-    p = (1.0 - s) * pl + s * pr;
-    if (order >= 1) v = (1.0 - s) * vl + s * vr + ds * (pr - pl);
-    if (order >= 2) a = (1.0 - s) * al + s * ar + 2.0 * ds * (vr - vl) + dds * (pr - pl);
+    placement.left = &windows[left];
+    placement.right = &windows[right];
+    Smoothstep((t - (boundary - half)) / (2.0 * half), &placement.s, &placement.ds, &placement.dds);
+    placement.ds /= 2.0 * half;
+    placement.dds /= 4.0 * half * half;
     return true;
   };
   if (!(k > 0 && blend(k - 1, k)) && k + 1 < windows.size()) blend(k, k + 1);
+  return placement;
+}
+
+void Curve::EvaluateUpTo(int64_t stamp_ns, int order, Eigen::Ref<Eigen::VectorXd> value,
+                         Eigen::Ref<Eigen::VectorXd>* derivative, Eigen::Ref<Eigen::VectorXd>* second_derivative,
+                         double tolerance_s) const {
+  const double t = static_cast<double>(stamp_ns - origin_ns_) * 1e-9;
+  const Placement placement = Locate(t, tolerance_s);
+  Point p, v, a;
+  EvaluateWindow(*placement.left, t, order, &p, &v, &a);
+  if (placement.right != nullptr) {
+    // The blend's derivatives need both windows' values and lower derivatives.
+    Point pr, vr, ar;
+    EvaluateWindow(*placement.right, t, order, &pr, &vr, &ar);
+    const double s = placement.s, ds = placement.ds, dds = placement.dds;
+    if (order >= 2) a = (1.0 - s) * a + s * ar + 2.0 * ds * (vr - v) + dds * (pr - p);
+    if (order >= 1) v = (1.0 - s) * v + s * vr + ds * (pr - p);
+    p = (1.0 - s) * p + s * pr;
+  }
   value = p;
   if (order >= 1) *derivative = v;
   if (order >= 2) *second_derivative = a;
+}
+
+void Curve::EvaluateMany(std::span<const int64_t> stamps_ns, int order, Eigen::MatrixXd* values,
+                         Eigen::MatrixXd* first, Eigen::MatrixXd* second, double tolerance_s) const {
+  if (order < 0 || order > 2 || values == nullptr || (order >= 1 && first == nullptr) ||
+      (order >= 2 && second == nullptr)) {
+    throw std::invalid_argument("Curve::EvaluateMany: order 0..2 with an output for each derivative");
+  }
+  const auto n = static_cast<Eigen::Index>(stamps_ns.size());
+  // Queries in time order, so that those a window serves are contiguous.
+  std::vector<Eigen::Index> sorted(static_cast<size_t>(n));
+  std::iota(sorted.begin(), sorted.end(), 0);
+  if (!std::is_sorted(stamps_ns.begin(), stamps_ns.end())) {
+    std::stable_sort(sorted.begin(), sorted.end(), [&](Eigen::Index i, Eigen::Index j) { return stamps_ns[i] < stamps_ns[j]; });
+  }
+  std::vector<double> t(static_cast<size_t>(n));
+  std::vector<Placement> placements(static_cast<size_t>(n));
+  for (Eigen::Index r = 0; r < n; ++r) {
+    t[r] = static_cast<double>(stamps_ns[sorted[r]] - origin_ns_) * 1e-9;
+    placements[r] = Locate(t[r], tolerance_s);
+  }
+  // Each window evaluated at a run of queries at once (vectorised Clenshaw), for the left and the
+  // right window of every query: (order + 1) blocks of n x d each.
+  const Eigen::Index d = dimension_;
+  std::array<Eigen::MatrixXd, 3> left, right;
+  for (int k = 0; k <= order; ++k) {
+    left[k].resize(n, d);
+    right[k].resize(n, d);
+  }
+  auto evaluate_runs = [&](bool use_right, std::array<Eigen::MatrixXd, 3>& out) {
+    for (Eigen::Index begin = 0; begin < n;) {
+      const CurveWindow* w = use_right ? placements[begin].right : placements[begin].left;
+      Eigen::Index end = begin + 1;
+      while (end < n && (use_right ? placements[end].right : placements[end].left) == w) ++end;
+      if (w != nullptr) {
+        Eigen::VectorXd x(end - begin);
+        for (Eigen::Index r = begin; r < end; ++r) x[r - begin] = w->series.interval.ToUnit(t[r]);
+        const double scale = w->series.interval.DerivativeScale();
+        out[0].middleRows(begin, end - begin) = EvaluateSeries(w->series.coefficients, x);
+        if (order >= 1) out[1].middleRows(begin, end - begin) = EvaluateSeries(w->first_derivative, x) * scale;
+        if (order >= 2) {
+          out[2].middleRows(begin, end - begin) = EvaluateSeries(w->second_derivative, x) * (scale * scale);
+        }
+      }
+      begin = end;
+    }
+  };
+  evaluate_runs(false, left);
+  evaluate_runs(true, right);
+  values->resize(n, d);
+  if (order >= 1) first->resize(n, d);
+  if (order >= 2) second->resize(n, d);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    const Placement& q = placements[r];
+    const Eigen::Index i = sorted[r];
+    if (q.right == nullptr) {
+      values->row(i) = left[0].row(r);
+      if (order >= 1) first->row(i) = left[1].row(r);
+      if (order >= 2) second->row(i) = left[2].row(r);
+      continue;
+    }
+    const double s = q.s, ds = q.ds, dds = q.dds;
+    const auto dp = right[0].row(r) - left[0].row(r);
+    values->row(i) = (1.0 - s) * left[0].row(r) + s * right[0].row(r);
+    if (order >= 1) first->row(i) = (1.0 - s) * left[1].row(r) + s * right[1].row(r) + ds * dp;
+    if (order >= 2) {
+      second->row(i) = (1.0 - s) * left[2].row(r) + s * right[2].row(r) +
+                       2.0 * ds * (right[1].row(r) - left[1].row(r)) + dds * dp;
+    }
+  }
+}
+
+Curve Curve::FromParts(int64_t origin_ns, std::vector<CurveSegment> segments, Eigen::VectorXd noise_sigma,
+                       Eigen::VectorXd residual_rms) {
+  if (segments.empty()) throw std::invalid_argument("Curve::FromParts: no segments");
+  const Eigen::Index d = segments.front().windows.empty() ? 0 : segments.front().windows.front().series.dimension();
+  if (d < 1 || d > 4) throw std::invalid_argument("Curve::FromParts: 1..4 coordinates");
+  double previous_end = -std::numeric_limits<double>::infinity();
+  for (CurveSegment& segment : segments) {
+    if (segment.windows.empty() || !(segment.begin <= segment.end) || !(segment.begin > previous_end)) {
+      throw std::invalid_argument("Curve::FromParts: segments must be non-empty, ordered and disjoint");
+    }
+    previous_end = segment.end;
+    for (size_t k = 0; k < segment.windows.size(); ++k) {
+      CurveWindow& w = segment.windows[k];
+      const bool tiles = k == 0 ? w.core_begin <= segment.begin : w.core_begin == segment.windows[k - 1].core_end;
+      if (w.series.dimension() != d || static_cast<Eigen::Index>(w.degrees.size()) != d || !tiles ||
+          !(w.core_begin < w.core_end) || !(w.fit_begin <= w.core_begin) || !(w.fit_end >= w.core_end) ||
+          !(w.series.interval.b > w.series.interval.a)) {
+        throw std::invalid_argument("Curve::FromParts: windows must tile their segment with consistent series");
+      }
+      WindowFitter::Finish(&w);
+    }
+  }
+  Curve curve;
+  curve.origin_ns_ = origin_ns;
+  curve.dimension_ = static_cast<int>(d);
+  curve.segments_ = std::move(segments);
+  curve.noise_sigma_ = std::move(noise_sigma);
+  curve.residual_rms_ = std::move(residual_rms);
+  return curve;
 }
 
 Eigen::Index Curve::stored_values() const {

@@ -152,26 +152,56 @@ NormalEquations BuildNormalEquationsUnchecked(const Eigen::Ref<const Eigen::Vect
   return normal;
 }
 
-ChebyshevSeries SolveNormalEquations(const NormalEquations& normal, int degree, double* gram_condition,
-                                     Eigen::VectorXd* variance_factors) {
+NestedCholesky::NestedCholesky(const NormalEquations& normal, int degree) {
   if (degree < 0 || degree > normal.top_degree()) {
-    throw std::invalid_argument("SolveNormalEquations: degree outside the normal equations");
+    throw std::invalid_argument("NestedCholesky: degree outside the normal equations");
   }
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(normal.gram.topLeftCorner(degree + 1, degree + 1));
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive() ||
-      ldlt.vectorD().minCoeff() <= 1e-13 * ldlt.vectorD().maxCoeff()) {
+  const Eigen::LLT<Eigen::MatrixXd> llt(normal.gram.topLeftCorner(degree + 1, degree + 1));
+  bool singular = llt.info() != Eigen::Success;
+  if (!singular) {
+    factor_ = llt.matrixL();
+    const Eigen::ArrayXd pivots = factor_.diagonal().array().square();
+    singular = !(pivots.minCoeff() > 1e-13 * pivots.maxCoeff());
+  }
+  if (singular) {
     throw ComputeError(fmt::format(
         "the degree-{} least-squares fit is singular: {} samples do not determine the polynomial "
         "(too few distinct stamps?)",
         degree, normal.samples));
   }
-  if (gram_condition != nullptr) *gram_condition = ldlt.vectorD().maxCoeff() / ldlt.vectorD().minCoeff();
-  if (variance_factors != nullptr) {
-    *variance_factors = ldlt.solve(Eigen::MatrixXd::Identity(degree + 1, degree + 1)).diagonal();
+}
+
+double NestedCholesky::Condition(int degree) const {
+  const Eigen::ArrayXd pivots = factor_.diagonal().head(degree + 1).array().square();
+  return pivots.maxCoeff() / pivots.minCoeff();
+}
+
+Eigen::MatrixXd NestedCholesky::Solve(int degree, const Eigen::Ref<const Eigen::MatrixXd>& rhs) const {
+  if (degree < 0 || degree > this->degree() || rhs.rows() < degree + 1) {
+    throw std::invalid_argument("NestedCholesky::Solve: degree outside the factorisation");
   }
+  const auto lower = factor_.topLeftCorner(degree + 1, degree + 1).triangularView<Eigen::Lower>();
+  Eigen::MatrixXd x = lower.solve(rhs.topRows(degree + 1));
+  lower.transpose().solveInPlace(x);
+  return x;
+}
+
+Eigen::VectorXd NestedCholesky::VarianceFactors(int degree) const {
+  // G⁻¹ = L⁻ᵀL⁻¹, so (G⁻¹)_kk is the squared norm of column k of L⁻¹.
+  const Eigen::MatrixXd inverse = factor_.topLeftCorner(degree + 1, degree + 1)
+                                      .triangularView<Eigen::Lower>()
+                                      .solve(Eigen::MatrixXd::Identity(degree + 1, degree + 1));
+  return inverse.colwise().squaredNorm().transpose();
+}
+
+ChebyshevSeries SolveNormalEquations(const NormalEquations& normal, int degree, double* gram_condition,
+                                     Eigen::VectorXd* variance_factors) {
+  const NestedCholesky cholesky(normal, degree);
+  if (gram_condition != nullptr) *gram_condition = cholesky.Condition(degree);
+  if (variance_factors != nullptr) *variance_factors = cholesky.VarianceFactors(degree);
   ChebyshevSeries series;
   series.interval = normal.interval;
-  series.coefficients = ldlt.solve(normal.rhs.topRows(degree + 1));
+  series.coefficients = cholesky.Solve(degree, normal.rhs);
   return series;
 }
 

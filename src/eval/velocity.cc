@@ -103,12 +103,10 @@ VelocityEstimate EstimateVelocity(const traj::TrajectoryView& trajectory, const 
   const Eigen::MatrixXd positions = trajectory.positions().transpose();
   cheb::Curve curve = cheb::FitCurve(trajectory.stamps_ns(), positions, options.curve);
   const std::span<const int64_t> query = at_ns ? *at_ns : trajectory.stamps_ns();
-  estimate.velocities.resize(3, static_cast<Eigen::Index>(query.size()));
-  Eigen::VectorXd p(3), v(3);
-  for (size_t i = 0; i < query.size(); ++i) {
-    curve.EvaluateVelocity(query[i], p, v);
-    estimate.velocities.col(static_cast<Eigen::Index>(i)) = v;
-  }
+  Eigen::MatrixXd values, derivatives;
+  curve.EvaluateMany(query, 1, &values, &derivatives);
+  estimate.positions = values.transpose();
+  estimate.velocities = derivatives.transpose();
   estimate.curve = std::move(curve);
   return estimate;
 }

@@ -1,5 +1,6 @@
 #include "cheval/cheb/curve.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -140,6 +141,43 @@ TEST(FitCurve, LongRecordingUsesBlendedWindowsThatJoinSmoothly) {
     EXPECT_LT((v1 - v0).norm(), 1e-5);
   }
   EXPECT_LT(VelocityRmse(curve, s), 0.2 * CentralDifferenceRmse(s));
+}
+
+// The batch evaluation gives the point-wise numbers, for queries in any order, in blending zones
+// and on both sides of a gap.
+TEST(FitCurve, EvaluateManyMatchesPointwiseEvaluation) {
+  Samples s = Sample(300.0, 100.0, 5e-4, 12);
+  Samples holed;
+  holed.values.resize(static_cast<Eigen::Index>(s.stamps.size()), 3);
+  Eigen::Index n = 0;
+  for (size_t i = 0; i < s.stamps.size(); ++i) {
+    const double t = static_cast<double>(s.stamps[i] - kEpoch) * 1e-9;
+    if (t > 100.0 && t < 102.0) continue;
+    holed.stamps.push_back(s.stamps[i]);
+    holed.values.row(n++) = s.values.row(static_cast<Eigen::Index>(i));
+  }
+  holed.values.conservativeResize(n, 3);
+  const Curve curve = FitCurve(holed.stamps, holed.values);
+  ASSERT_EQ(curve.segments().size(), 2u);
+  ASSERT_GT(curve.segments()[1].windows.size(), 2u);
+  std::vector<int64_t> queries = holed.stamps;
+  std::mt19937_64 rng(13);
+  std::shuffle(queries.begin(), queries.end(), rng);
+  Eigen::MatrixXd values, first, second;
+  curve.EvaluateMany(queries, 2, &values, &first, &second);
+  Eigen::VectorXd p(3), v(3), a(3);
+  for (size_t i = 0; i < queries.size(); ++i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    curve.Evaluate(queries[i], p, v, a);
+    ASSERT_LE((values.row(r).transpose() - p).cwiseAbs().maxCoeff(), 1e-12 * (1.0 + p.cwiseAbs().maxCoeff()));
+    ASSERT_LE((first.row(r).transpose() - v).cwiseAbs().maxCoeff(), 1e-9 * (1.0 + v.cwiseAbs().maxCoeff()));
+    ASSERT_LE((second.row(r).transpose() - a).cwiseAbs().maxCoeff(), 1e-7 * (1.0 + a.cwiseAbs().maxCoeff()));
+  }
+  Eigen::MatrixXd only_values;
+  curve.EvaluateMany(queries, 0, &only_values);
+  EXPECT_EQ(only_values, values);
+  const std::vector<int64_t> in_gap{kEpoch + 101'000'000'000LL};
+  EXPECT_THROW(curve.EvaluateMany(in_gap, 0, &only_values), ComputeError);
 }
 
 TEST(FitCurve, AbsoluteEpochStampsLoseNothing) {

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <random>
 
+#include <Eigen/LU>
 #include <Eigen/QR>
 #include <gtest/gtest.h>
 
@@ -40,6 +41,32 @@ TEST(FitLeastSquares, MatchesDenseQrWithWeightsAndJitter) {
   const Eigen::MatrixXd reference = DenseFit(x, z, degree, w);
   // Normal equations lose ~cond(A) ≈ 10 digits-wise nothing here; agreement to 1e-10 is expected.
   EXPECT_LE((fit.coefficients - reference).cwiseAbs().maxCoeff(), 1e-10);
+}
+
+// One factorisation at the top degree gives every lower-degree fit: each equals the dense fit of
+// that degree, and the variance factors equal diag(G⁻¹) of that block.
+TEST(NestedCholesky, LeadingBlocksGiveEveryLowerDegreeFit) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> normal;
+  const int m = 1500, top = 40;
+  const Interval interval{-1.0, 4.0};
+  Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(m, -1.0, 4.0);
+  Eigen::MatrixXd z(m, 2);
+  for (int i = 0; i < m; ++i) z.row(i) << std::exp(-t[i] * t[i]) + 0.001 * normal(rng), std::sin(3 * t[i]);
+  const NormalEquations equations = BuildNormalEquations(t, z, top, interval);
+  const NestedCholesky cholesky(equations, top);
+  Eigen::VectorXd x(m);
+  for (int i = 0; i < m; ++i) x[i] = interval.ToUnit(t[i]);
+  for (int degree : {0, 1, 5, 17, 40}) {
+    const Eigen::MatrixXd reference = DenseFit(x, z, degree, Eigen::VectorXd::Ones(m));
+    EXPECT_LE((cholesky.Solve(degree, equations.rhs) - reference).cwiseAbs().maxCoeff(), 1e-11) << degree;
+    const Eigen::MatrixXd inverse = equations.gram.topLeftCorner(degree + 1, degree + 1).inverse();
+    EXPECT_LE((cholesky.VarianceFactors(degree) - inverse.diagonal()).cwiseAbs().maxCoeff(),
+              1e-12 * inverse.diagonal().cwiseAbs().maxCoeff())
+        << degree;
+    EXPECT_GE(cholesky.Condition(degree), 1.0);
+  }
+  EXPECT_THROW(cholesky.Solve(top + 1, equations.rhs), std::invalid_argument);
 }
 
 TEST(FitLeastSquares, ReproducesPolynomialsExactly) {

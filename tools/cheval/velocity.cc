@@ -81,7 +81,6 @@ std::string FormatOutput(const traj::TrajectoryView& input, std::span<const int6
                          const eval::VelocityEstimate& estimate) {
   fmt::memory_buffer out;
   auto it = std::back_inserter(out);
-  Eigen::VectorXd p(3), v(3), a(3);
   for (size_t i = 0; i < stamps.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
     Eigen::Vector3d position;
@@ -94,8 +93,7 @@ std::string FormatOutput(const traj::TrajectoryView& input, std::span<const int6
         q = input.UnitQuaternion(k).coeffs();
       }
     } else {
-      estimate.curve->Evaluate(stamps[i], p, v, a);
-      position = p;
+      position = estimate.positions.col(k);
       if (input.has_orientation()) {
         // Slerp between the input's neighbouring orientations (stamps sorted by the caller's file).
         const auto s = input.stamps_ns();

@@ -54,11 +54,35 @@ NormalEquations BuildNormalEquationsUnchecked(const Eigen::Ref<const Eigen::Vect
                                               const Eigen::Ref<const Eigen::MatrixXd>& z, int top,
                                               const Interval& interval, const Eigen::VectorXd* weights = nullptr);
 
-/// Solves the degree-N fit from normal equations built up to at least N. Throws ComputeError when
-/// the system is singular (LDLᵀ pivots spanning more than 1e13). If `gram_condition` is given it
-/// receives max/min of those pivots, an estimate of the normal matrix's condition number (the square
-/// of the samples'). If `variance_factors` is given it receives diag(G⁻¹): with unit weights and
-/// white noise of standard deviation σ, coefficient k has standard deviation σ·sqrt(factor_k).
+/// One Cholesky factorisation G = L·Lᵀ of normal equations serves the fit of every degree up to
+/// its own: without pivoting, the factor of a leading block of G is the leading block of L. So a
+/// degree search (cross-validation, the per-coordinate degrees of a window) costs one O(N³)
+/// factorisation and O(N²) per candidate instead of O(N³) per candidate.
+class NestedCholesky {
+ public:
+  /// Factorises the leading (degree + 1) x (degree + 1) block of `normal.gram`. Throws
+  /// ComputeError when that block is singular (Cholesky pivots L_kk² spanning more than 1e13):
+  /// the samples do not determine a polynomial of that degree.
+  NestedCholesky(const NormalEquations& normal, int degree);
+
+  int degree() const { return static_cast<int>(factor_.rows()) - 1; }
+  /// max/min of the pivots L_kk² up to `degree`: a lower bound of the condition number of that
+  /// block of G (the square of the samples' condition number).
+  double Condition(int degree) const;
+  /// Coefficients ((degree + 1) x d) of the degree-`degree` fit to right-hand sides whose first
+  /// degree + 1 rows are used (e.g. NormalEquations::rhs).
+  Eigen::MatrixXd Solve(int degree, const Eigen::Ref<const Eigen::MatrixXd>& rhs) const;
+  /// diag(G⁻¹) of the degree-`degree` block: with unit weights and white noise of standard
+  /// deviation σ, coefficient k of that fit has standard deviation σ·sqrt(factor_k).
+  Eigen::VectorXd VarianceFactors(int degree) const;
+
+ private:
+  Eigen::MatrixXd factor_;  // lower triangular L
+};
+
+/// Solves the degree-N fit from normal equations built up to at least N (NestedCholesky). Throws
+/// ComputeError when the system is singular. If `gram_condition` is given it receives
+/// NestedCholesky::Condition; if `variance_factors` is given, NestedCholesky::VarianceFactors.
 ChebyshevSeries SolveNormalEquations(const NormalEquations& normal, int degree, double* gram_condition = nullptr,
                                      Eigen::VectorXd* variance_factors = nullptr);
 

@@ -40,6 +40,8 @@ struct VelocityOptions {
 struct VelocityEstimate {
   /// 3 x n world-frame velocities (m/s) at the query stamps.
   Eigen::Matrix3Xd velocities;
+  /// kChebyshev only: 3 x n fitted positions at the query stamps; empty otherwise.
+  Eigen::Matrix3Xd positions;
   /// kChebyshev only: the fitted curve (windows, degrees, noise, residuals); empty otherwise.
   std::optional<cheb::Curve> curve;
 };
