@@ -358,14 +358,6 @@ void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegme
   }
 }
 
-// Quintic smoothstep s(u) = 6u⁵ - 15u⁴ + 10u³ and its first two derivatives in u: C² blending.
-void Smoothstep(double u, double* s, double* ds, double* dds) {
-  u = std::clamp(u, 0.0, 1.0);
-  *s = u * u * u * (u * (6.0 * u - 15.0) + 10.0);
-  *ds = 30.0 * u * u * (1.0 - u) * (1.0 - u);
-  *dds = 60.0 * u * (1.0 - u) * (1.0 - 2.0 * u);
-}
-
 // Up to 4 coordinates, on the stack: evaluation allocates nothing.
 using Point = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 4, 1>;
 
@@ -396,6 +388,13 @@ void EvaluateWindow(const CurveWindow& w, double t, int order, Point* p, Point* 
 }
 
 }  // namespace
+
+void Smoothstep(double u, double* s, double* ds, double* dds) {
+  u = std::clamp(u, 0.0, 1.0);
+  *s = u * u * u * (u * (6.0 * u - 15.0) + 10.0);
+  *ds = 30.0 * u * u * (1.0 - u) * (1.0 - u);
+  *dds = 60.0 * u * (1.0 - u) * (1.0 - 2.0 * u);
+}
 
 Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen::MatrixXd>& values,
                const CurveOptions& options) {

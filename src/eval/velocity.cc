@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "cheval/common/error.h"
+#include "cheval/lie/so3.h"
 
 namespace cheval::eval {
 namespace {
@@ -33,6 +34,21 @@ Eigen::Matrix3Xd CentralDifferences(const traj::TrajectoryView& trajectory) {
     v.col(i) = (p.col(b) - p.col(a)) / (static_cast<double>(s[b] - s[a]) * 1e-9);
   }
   return v;
+}
+
+// Body angular velocity by central differences on the group: Log(R_aᵀ R_b) / (t_b − t_a) with
+// a = i − 1, b = i + 1 (one-sided at the ends).
+Eigen::Matrix3Xd CentralAngularDifferences(const traj::TrajectoryView& trajectory) {
+  using SO3 = lie::SO3<double>;
+  const Eigen::Index n = trajectory.size();
+  const auto s = trajectory.stamps_ns();
+  Eigen::Matrix3Xd w(3, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Index a = std::max<Eigen::Index>(i - 1, 0), b = std::min<Eigen::Index>(i + 1, n - 1);
+    w.col(i) = (SO3(trajectory.UnitQuaternion(a)).Inverse() * SO3(trajectory.UnitQuaternion(b))).Log() /
+               (static_cast<double>(s[b] - s[a]) * 1e-9);
+  }
+  return w;
 }
 
 Eigen::Matrix3Xd SavitzkyGolay(const traj::TrajectoryView& trajectory, int window) {
@@ -91,13 +107,21 @@ std::optional<VelocityMethod> VelocityMethodFromString(std::string_view name) {
 VelocityEstimate EstimateVelocity(const traj::TrajectoryView& trajectory, const VelocityOptions& options,
                                   std::optional<std::span<const int64_t>> at_ns) {
   VelocityEstimate estimate;
+  if (options.angular && !trajectory.has_orientation()) {
+    throw UsageError("--angular needs orientations, but the trajectory has positions only");
+  }
   if (options.method != VelocityMethod::kChebyshev) {
     if (at_ns) {
       throw UsageError(fmt::format("--at needs --method chebyshev: {} gives velocity only at the input's own stamps",
                                    ToString(options.method)));
     }
+    if (options.angular && options.method != VelocityMethod::kCentral) {
+      throw UsageError(fmt::format("--angular works with --method chebyshev or central, not {}",
+                                   ToString(options.method)));
+    }
     estimate.velocities = options.method == VelocityMethod::kCentral ? CentralDifferences(trajectory)
                                                                       : SavitzkyGolay(trajectory, options.savgol_window);
+    if (options.angular) estimate.angular_velocities = CentralAngularDifferences(trajectory);
     return estimate;
   }
   const Eigen::MatrixXd positions = trajectory.positions().transpose();
@@ -108,6 +132,15 @@ VelocityEstimate EstimateVelocity(const traj::TrajectoryView& trajectory, const 
   estimate.positions = values.transpose();
   estimate.velocities = derivatives.transpose();
   estimate.curve = std::move(curve);
+  if (options.angular) {
+    std::vector<Eigen::Quaterniond> rotations(static_cast<size_t>(trajectory.size()));
+    for (Eigen::Index i = 0; i < trajectory.size(); ++i) rotations[i] = trajectory.UnitQuaternion(i);
+    RotationCurveOptions rotation_options;
+    rotation_options.curve = options.curve;
+    RotationCurve rotation = FitRotationCurve(trajectory.stamps_ns(), rotations, rotation_options);
+    rotation.EvaluateMany(query, &estimate.orientations, &estimate.angular_velocities);
+    estimate.rotation_curve = std::move(rotation);
+  }
   return estimate;
 }
 

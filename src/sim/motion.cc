@@ -179,7 +179,7 @@ class Random {
   bool has_spare_ = false;
 };
 
-enum Stream : uint64_t { kShape = 1, kGaps, kDropout, kJitter, kNoise, kAddNoise };
+enum Stream : uint64_t { kShape = 1, kGaps, kDropout, kJitter, kNoise, kAddNoise, kRotationNoise };
 
 // ---------------------------------------------------------------------------------------------
 // The kinds. Each is p(t) = ∫_0^t u(τ) dτ + q(t) with u = Integrand (only when kIntegrated) and
@@ -676,6 +676,10 @@ traj::Trajectory Measure(const MotionModel& model, const MeasurementOptions& mea
     throw UsageError(fmt::format("--jitter must be a non-negative number of seconds below --duration ({} s), got {}",
                                  duration, jitter));
   }
+  const double rotation_noise = measurement.rotation_noise_rad;
+  if (!(rotation_noise >= 0) || !std::isfinite(rotation_noise)) {
+    throw UsageError(fmt::format("--rotation-noise must be a non-negative number of radians, got {}", rotation_noise));
+  }
   const double dropout = measurement.dropout_probability;
   if (!(dropout >= 0) || !(dropout < 1)) {
     throw UsageError(fmt::format("--dropout must be a probability in [0, 1), got {}", dropout));
@@ -709,11 +713,12 @@ traj::Trajectory Measure(const MotionModel& model, const MeasurementOptions& mea
     gaps.emplace_back(std::llround(begin * 1e9), std::llround((begin + gap_s) * 1e9));
   }
   Random dropout_random(options.seed, kDropout), jitter_random(options.seed, kJitter),
-      noise_random(options.seed, kNoise);
+      noise_random(options.seed, kNoise), rotation_random(options.seed, kRotationNoise);
 
   struct Sample {
     int64_t stamp;
     Eigen::Vector3d noise;
+    Eigen::Vector3d rotation_noise;
   };
   std::vector<Sample> kept;
   kept.reserve(nominal.size());
@@ -723,11 +728,12 @@ traj::Trajectory Measure(const MotionModel& model, const MeasurementOptions& mea
     const bool dropped = dropout_random.Uniform() < dropout;
     const double offset_s = jitter_random.Normal() * jitter;
     const Eigen::Vector3d n(noise_random.Normal(), noise_random.Normal(), noise_random.Normal());
+    const Eigen::Vector3d r(rotation_random.Normal(), rotation_random.Normal(), rotation_random.Normal());
     const int64_t offset = stamp - start;
     while (gap < gaps.size() && offset >= gaps[gap].second) ++gap;
     const bool in_gap = gap < gaps.size() && offset >= gaps[gap].first;
     if (dropped || in_gap) continue;
-    kept.push_back({stamp + static_cast<int64_t>(std::llround(offset_s * 1e9)), noise * n});
+    kept.push_back({stamp + static_cast<int64_t>(std::llround(offset_s * 1e9)), noise * n, rotation_noise * r});
   }
   if (kept.size() < 2) {
     throw UsageError(fmt::format("--dropout {} and the gaps leave {} of {} samples; at least 2 are needed", dropout,
@@ -747,7 +753,15 @@ traj::Trajectory Measure(const MotionModel& model, const MeasurementOptions& mea
   const auto quaternions = truth.View().quaternions();
   for (Eigen::Index i = 0; i < truth.size(); ++i) {
     const Eigen::Vector3d p = truth.positions().col(i) + kept[static_cast<size_t>(i)].noise;
-    const Eigen::Vector4d q = quaternions.col(i);
+    Eigen::Vector4d q = quaternions.col(i);
+    const Eigen::Vector3d& r = kept[static_cast<size_t>(i)].rotation_noise;
+    if (rotation_noise > 0) {
+      const double angle = r.norm();
+      const Eigen::Quaterniond perturbed =
+          Eigen::Quaterniond(q[3], q[0], q[1], q[2]) *
+          Eigen::Quaterniond(Eigen::AngleAxisd(angle, angle > 0 ? Eigen::Vector3d(r / angle) : Eigen::Vector3d::UnitX()));
+      q << perturbed.x(), perturbed.y(), perturbed.z(), perturbed.w();
+    }
     measured.Append(stamps[static_cast<size_t>(i)], p.data(), q.data());
   }
   return measured;

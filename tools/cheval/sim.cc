@@ -40,6 +40,10 @@ void RegisterSim(CLI::App& app, Action* action) {
       "--rate", flags->rate_hz, "Sample rate (Hz); default per kind: car 50, legged 200, drone 200, handheld 100");
   motion->add_option("--noise", flags->measurement.noise_m, "Position noise sigma (m) of the measured file")
       ->capture_default_str();
+  motion
+      ->add_option("--rotation-noise", flags->measurement.rotation_noise_rad,
+                   "Orientation noise sigma (rad) of the measured file: R Exp(n), n ~ N(0, sigma^2 I)")
+      ->capture_default_str();
   motion->add_option("--jitter", flags->measurement.jitter_s, "Stamp jitter sigma (s) of the measured file")
       ->capture_default_str();
   motion

@@ -142,6 +142,10 @@ class Curve {
   Eigen::VectorXd residual_rms_;
 };
 
+/// Quintic smoothstep s(u) = 6u⁵ − 15u⁴ + 10u³ on u clamped to [0, 1], with ds/du and d²s/du²:
+/// the C² blending weight of overlapping fits.
+void Smoothstep(double u, double* s, double* ds, double* dds);
+
 /// Fits `values` (m x d, d <= 4; row i sampled at stamps_ns[i]) with a Curve. Stamps need not be
 /// sorted or unique (samples are sorted by stamp; equal stamps are averaged by the least squares).
 /// Throws ComputeError for fewer than 2 samples, all-equal stamps, or a fixed degree above what a

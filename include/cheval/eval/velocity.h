@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "cheval/cheb/curve.h"
+#include "cheval/eval/rotation_curve.h"
 #include "cheval/traj/trajectory.h"
 
 namespace cheval::eval {
@@ -34,6 +35,9 @@ struct VelocityOptions {
   /// kSavitzkyGolay: window length in samples (odd, >= 5); the polynomial is cubic. Uses the
   /// actual stamps (a local fit in time), so uneven sampling is handled.
   int savgol_window = 21;
+  /// Also body angular velocity from the orientations (kChebyshev: a RotationCurve fitted with the
+  /// same curve options; kCentral: central differences on the group). Needs orientations.
+  bool angular = false;
 };
 
 /// Velocities and what the Chebyshev fit chose.
@@ -44,6 +48,11 @@ struct VelocityEstimate {
   Eigen::Matrix3Xd positions;
   /// kChebyshev only: the fitted curve (windows, degrees, noise, residuals); empty otherwise.
   std::optional<cheb::Curve> curve;
+  /// With `angular`: 3 x n body angular velocities (rad/s) at the query stamps.
+  Eigen::Matrix3Xd angular_velocities;
+  /// With `angular` and kChebyshev: the fitted orientations at the query stamps and the curve.
+  std::vector<Eigen::Quaterniond> orientations;
+  std::optional<RotationCurve> rotation_curve;
 };
 
 /// Estimates world-frame velocity at `at_ns` (nullopt: at the trajectory's own stamps) from its

@@ -78,6 +78,9 @@ struct MeasurementOptions {
   /// ends; nominal samples with stamp offset in [start, start + gap_s) are removed. >= 0.
   int gap_count = 0;
   double gap_s = 0.0;  ///< --gap-seconds: length of each gap, > 0 exactly when gap_count > 0
+  /// --rotation-noise: σ in radians of the body-frame perturbation of each measured orientation,
+  /// R_measured = R·Exp(n) with n ~ N(0, σ²I₃) (>= 0; motion capture: ~0.002-0.01 rad).
+  double rotation_noise_rad = 0.0;
 };
 
 /// The exact state at one time.
@@ -133,7 +136,7 @@ traj::Trajectory GenerateMotion(const MotionOptions& options);
 /// The measured copy of `model` (positions and quaternions; no velocity channels): nominal grid
 /// samples are removed by the gaps and dropouts, the survivors' stamps jittered (see
 /// MeasurementOptions::jitter_s), and each position is the exact truth at its final stamp plus
-/// N(0, noise_m²) per coordinate; orientations are the exact truth (no orientation noise).
+/// N(0, noise_m²) per coordinate; orientations are the truth perturbed by rotation_noise_rad.
 /// Deterministic in the model's seed. Throws UsageError naming the option for a negative or
 /// non-finite noise or jitter, a jitter not below the duration, a dropout outside [0, 1), a negative
 /// gap count, gap seconds that are not positive exactly when the gap count is, gaps that do not fit
