@@ -6,11 +6,13 @@
 // the best window of a grid (an oracle choice: it is told the truth), and one global Chebyshev fit
 // of fixed degree 400 (the C-ASE paper's choice for CARLA). Ratios are against the baseline
 // measured in the same run. A second table: body angular velocity from noisy orientations.
-//   build/bench/velocity_accuracy [DATA_DIR]
+//   build/bench/velocity_accuracy [DATA_DIR [SEEDS]]
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <string>
+
+#include <fmt/format.h>
 
 #include "cheval/common/error.h"
 #include "cheval/eval/velocity.h"
@@ -115,6 +117,10 @@ void AngularTable() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const std::string data = argc > 1 ? argv[1] : "../shared/data";
+  // Optional: the number of simulator seeds per kind and noise (default 1), to see that the
+  // figures are not one lucky draw.
+  const uint64_t seeds = argc > 2 ? std::stoull(argv[2]) : 1;
   std::printf("velocity RMSE in mm/s, full range unless marked inner (middle 90 %%)\n\n");
   std::printf("| %-28s | %10s | %10s | %10s | %10s | %10s | %16s | %10s | %6s | %6s | %6s |\n", "trajectory",
               "cheval (cv)", "inner", "chop", "threshold", "central", "SG best (win)", "global 400", "/cent", "/SG", "s");
@@ -122,20 +128,22 @@ int main(int argc, char** argv) {
   for (sim::MotionKind kind :
        {sim::MotionKind::kCar, sim::MotionKind::kLegged, sim::MotionKind::kDrone, sim::MotionKind::kHandheld}) {
     for (double noise : {0.0, 0.0005, 0.002}) {
-      sim::MotionOptions options;
-      options.kind = kind;
-      options.seed = 1;
-      const sim::MotionModel model(options);
-      sim::MeasurementOptions measurement;
-      measurement.noise_m = noise;
-      const traj::Trajectory measured = sim::Measure(model, measurement);
-      const traj::Trajectory truth = sim::SampleMotion(model, measured.stamps_ns());
-      char name[64];
-      std::snprintf(name, sizeof(name), "%s, %.1f mm", std::string(sim::ToString(kind)).c_str(), 1e3 * noise);
-      Print(Evaluate(name, measured.View(), truth.View().velocities()));
+      for (uint64_t seed = 1; seed <= seeds; ++seed) {
+        sim::MotionOptions options;
+        options.kind = kind;
+        options.seed = seed;
+        const sim::MotionModel model(options);
+        sim::MeasurementOptions measurement;
+        measurement.noise_m = noise;
+        const traj::Trajectory measured = sim::Measure(model, measurement);
+        const traj::Trajectory truth = sim::SampleMotion(model, measured.stamps_ns());
+        char name[64];
+        std::snprintf(name, sizeof(name), "%s, %.1f mm%s", std::string(sim::ToString(kind)).c_str(), 1e3 * noise,
+                      seeds > 1 ? fmt::format(", seed {}", seed).c_str() : "");
+        Print(Evaluate(name, measured.View(), truth.View().velocities()));
+      }
     }
   }
-  const std::string data = argc > 1 ? argv[1] : "../shared/data";
   for (const char* file : {"MH_05_difficult.csv", "V1_01_easy.csv", "V1_02_medium.csv", "V2_02_medium.csv"}) {
     const std::string path = data + "/ov_data/euroc_mav/" + file;
     if (!std::filesystem::exists(path)) {

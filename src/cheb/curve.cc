@@ -143,6 +143,9 @@ class WindowFitter {
       // resolved window for kCrossValidation: held-out error alone cannot tell an unresolved window
       // (every candidate underfits) from a resolved one.
       resolved = ChopDegrees(high, m, &window.degrees);
+      // The chop looks for a plateau by shape, which a short noisy window can hide: when the top
+      // third of the coefficients is statistically pure noise, the window is resolved anyway.
+      if (!resolved) resolved = TailIsNoise(high, cholesky->VarianceFactors(top));
       if (cross_validate && (resolved || !may_split)) window.degrees = CrossValidatedDegrees(*folds, top);
     }
     if (!resolved && may_split) return std::nullopt;
@@ -157,6 +160,26 @@ class WindowFitter {
     }
     Finish(&window);
     return window;
+  }
+
+  // Whether the top third of a probe's coefficients ((top + 1) x d) is consistent with white noise
+  // of the estimated σ in every coordinate: with σ_k = σ·sqrt((G⁻¹)_kk) the standard deviation of
+  // coefficient k, Σ (c_k/σ_k)² over the n tail coefficients is χ²(n) for pure noise; the tail is
+  // noise when it stays below n + 4·sqrt(2n) (about 4 standard deviations of χ²(n)). Needs a
+  // tail of at least 8 coefficients and σ > 0 (noise-free data are left to the chop).
+  bool TailIsNoise(const Eigen::MatrixXd& high, const Eigen::VectorXd& variance_factors) const {
+    const Eigen::Index top = high.rows() - 1, n = (top + 1) / 3;
+    if (n < 8) return false;
+    const double limit = static_cast<double>(n) + 4.0 * std::sqrt(2.0 * static_cast<double>(n));
+    for (Eigen::Index c = 0; c < high.cols(); ++c) {
+      if (!(sigma_[c] > 0.0)) return false;
+      double chi2 = 0.0;
+      for (Eigen::Index k = top + 1 - n; k <= top; ++k) {
+        chi2 += high(k, c) * high(k, c) / (sigma_[c] * sigma_[c] * variance_factors[k]);
+      }
+      if (!(chi2 <= limit)) return false;
+    }
+    return true;
   }
 
   // Derivative coefficients of a fitted window.
