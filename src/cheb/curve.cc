@@ -89,6 +89,14 @@ class WindowFitter {
     int top = static_cast<int>(std::min<double>(
         {static_cast<double>(options_.max_degree), std::floor(std::sqrt(options_.max_conditioning * m)),
          static_cast<double>(distinct - 1)}));
+    // A window far longer than its top degree needs (m > top², e.g. the whole of an hour-long
+    // recording) is usually split: a subsample with N²/m = 2 (well conditioned, coefficient noise
+    // still white) tells that at a fraction of the cost. Only its "unresolved" is trusted: a
+    // subsample's noise plateau is higher, so it resolves no less than all the samples would.
+    if (may_split && options_.degree_method != DegreeMethod::kThreshold) {
+      const Eigen::Index stride = m / std::max<Eigen::Index>(Eigen::Index{top} * top / 2, 16 * (top + 1));
+      if (stride >= 2 && !ResolvedOnSubsample(tw, zw, stride, top, interval)) return std::nullopt;
+    }
     // Cross-validation needs the normal equations of each fold; their sum is the whole window's,
     // so the samples are visited once either way.
     const bool cross_validate = options_.degree_method == DegreeMethod::kCrossValidation;
@@ -180,6 +188,29 @@ class WindowFitter {
       if (!(chi2 <= limit)) return false;
     }
     return true;
+  }
+
+  // Whether every `stride`-th sample resolves the window at degree `top` (true when that cannot
+  // be told: an ill-conditioned subsample).
+  bool ResolvedOnSubsample(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
+                           Eigen::Index stride, int top, const Interval& interval) const {
+    const Eigen::Index count = (t.size() + stride - 1) / stride;
+    Eigen::VectorXd st(count);
+    Eigen::MatrixXd sz(count, z.cols());
+    for (Eigen::Index i = 0; i < count; ++i) {
+      st[i] = t[i * stride];
+      sz.row(i) = z.row(i * stride);
+    }
+    const NormalEquations normal = BuildNormalEquationsUnchecked(st, sz, top, interval);
+    try {
+      const NestedCholesky cholesky(normal, top);
+      if (!(cholesky.Condition(top) <= kMaxGramCondition)) return true;
+      const Eigen::MatrixXd high = cholesky.Solve(top, normal.rhs);
+      std::vector<int> degrees(static_cast<size_t>(z.cols()));
+      return ChopDegrees(high, count, &degrees) || TailIsNoise(high, cholesky.VarianceFactors(top));
+    } catch (const ComputeError&) {
+      return true;
+    }
   }
 
   // Derivative coefficients of a fitted window.
