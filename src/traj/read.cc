@@ -118,7 +118,41 @@ bool IsHeaderRow(const std::vector<Field>& fields) {
   return true;
 }
 
-// Parses a double with std::from_chars; accepts a leading '+'. nullopt on anything else.
+// std::from_chars reports result_out_of_range alike for a decimal beyond the largest double (~1.8e308)
+// and for one that rounds to zero (below half the smallest subnormal, ~2.5e-324). Tells which from
+// the power of ten of the leading significant digit, which is then >= 308 or <= -324: true for the
+// tiny one. `text` is what from_chars matched: [-]digits[.digits][(e|E)[+|-]digits].
+bool RoundsToZero(std::string_view text) {
+  size_t i = !text.empty() && text.front() == '-' ? 1 : 0;
+  int64_t integer_digits = 0;  // before the point, leading zeros excluded
+  int64_t fraction_zeros = 0;  // after the point, before the first nonzero digit
+  bool point = false, fraction_nonzero = false;
+  for (; i < text.size() && text[i] != 'e' && text[i] != 'E'; ++i) {
+    const char c = text[i];
+    if (c == '.') {
+      point = true;
+    } else if (!point) {
+      if (integer_digits > 0 || c != '0') ++integer_digits;
+    } else if (!fraction_nonzero) {
+      if (c == '0') ++fraction_zeros; else fraction_nonzero = true;
+    }
+  }
+  int64_t exponent = 0;
+  bool negative_exponent = false;
+  if (i < text.size()) {
+    ++i;  // 'e'
+    if (i < text.size() && (text[i] == '+' || text[i] == '-')) negative_exponent = text[i++] == '-';
+    // Saturates: any exponent beyond 1e15 is far outside a double either way.
+    for (; i < text.size(); ++i) exponent = std::min<int64_t>(exponent * 10 + (text[i] - '0'), 1'000'000'000'000'000);
+  }
+  const int64_t leading = integer_digits > 0 ? integer_digits - 1 : -fraction_zeros - 1;
+  return leading + (negative_exponent ? -exponent : exponent) < 0;
+}
+
+// Parses a double with std::from_chars; accepts a leading '+'. nullopt on anything else. A decimal
+// too large for a double gives ±inf (Number() reports it). One too small to be told from zero gives
+// ±0: that is its correctly rounded value, the one strtod, Python's float() and numpy.loadtxt (so
+// evo) give, just as 1e-320 rounds to a subnormal and 0.1 to the nearest double.
 std::optional<double> ParseDouble(std::string_view text) {
   if (!text.empty() && text.front() == '+') text.remove_prefix(1);
   if (text.empty() || text.front() == '+' || (text.front() == '-' && text.size() > 1 && text[1] == '+')) {
@@ -126,8 +160,12 @@ std::optional<double> ParseDouble(std::string_view text) {
   }
   double value = 0.0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec == std::errc::result_out_of_range) return std::numeric_limits<double>::infinity();
-  if (ec != std::errc() || end != text.data() + text.size()) return std::nullopt;
+  if (end != text.data() + text.size()) return std::nullopt;  // trailing garbage, or no number at all
+  if (ec == std::errc::result_out_of_range) {
+    const double magnitude = RoundsToZero(text) ? 0.0 : std::numeric_limits<double>::infinity();
+    return text.front() == '-' ? -magnitude : magnitude;
+  }
+  if (ec != std::errc()) return std::nullopt;
   return value;
 }
 
@@ -144,6 +182,8 @@ struct Layout {
   OrientationKind orientation = OrientationKind::kQuaternion;
   bool euler = false;
   size_t first_quaternion_field = 0;  // for the zero-norm message
+  // Fields after those of `roles` must still be numbers (EuRoC's biases); else they are ignored.
+  bool numbers_after_roles = false;
 };
 
 std::vector<std::string> Split(std::string_view names) {
@@ -178,10 +218,16 @@ Layout MakeLayout(const ColumnMap& map, char separator, Format format) {
   return layout;
 }
 
-Layout TumLayout(bool velocity) {
-  Layout layout = MakeLayout(ColumnMap{RolesOf(velocity ? "t,px,py,pz,qx,qy,qz,qw,vx,vy,vz" : "t,px,py,pz,qx,qy,qz,qw")},
-                             ' ', velocity ? Format::kTumV : Format::kTum);
-  layout.names = Split(velocity ? "t x y z qx qy qz qw vx vy vz" : "t x y z qx qy qz qw");
+// TUM (8 fields), TUM + velocity (11) and TUM + velocity + body angular velocity (14, what
+// `cheval velocity --angular` and `cheval sim motion --truth` write). For tumv the first row
+// decides between 11 and 14 (FixLayoutFromFirstRow).
+Layout TumLayout(bool velocity, bool angular = false) {
+  const char* roles = angular    ? "t,px,py,pz,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz"
+                      : velocity ? "t,px,py,pz,qx,qy,qz,qw,vx,vy,vz"
+                                 : "t,px,py,pz,qx,qy,qz,qw";
+  Layout layout = MakeLayout(ColumnMap{RolesOf(roles)}, ' ', velocity ? Format::kTumV : Format::kTum);
+  layout.names = Split("t x y z qx qy qz qw vx vy vz wx wy wz");
+  layout.names.resize(layout.roles.size());
   layout.field_counts = {layout.roles.size()};
   return layout;
 }
@@ -275,10 +321,16 @@ class Reader {
       if (count == 8 || count >= 11) {
         layout = NanosecondCsvLayout(Format::kEuroc, count >= 11);
         layout.field_counts = {count};
+        // cheval does not use the biases (bw, ba) or what follows them, but a non-number there
+        // means a broken file, which skipping them would hide (evo converts every column to float
+        // and rejects it too).
+        layout.numbers_after_roles = true;
       } else {
         Fail(scanner_.end_column(),
              fmt::format("expected 8 fields (t_ns px py pz qw qx qy qz) or at least 11 (... vx vy vz), got {}", count));
       }
+    } else if (layout.format == Format::kTumV && layout.field_counts.size() == 1 && count == 14) {
+      layout = TumLayout(true, true);
     } else if (layout.format == Format::kVins && layout.field_counts.empty()) {
       if (count == 8 || count == 11) {
         layout = NanosecondCsvLayout(Format::kVins, count == 11);
@@ -321,7 +373,11 @@ class Reader {
       Fail(field.column, fmt::format("expected a number for {}, got '{}'", FieldName(layout, index), field.text));
     }
     if (!std::isfinite(*value)) {
-      Fail(field.column, fmt::format("{} is '{}'; expected a finite number", FieldName(layout, index), field.text));
+      // Either spelt as such ("inf", "nan", ...) or a decimal beyond the range of a double.
+      const size_t first = field.text.find_first_not_of("+-");
+      const bool spelt = first != std::string_view::npos && std::isalpha(static_cast<unsigned char>(field.text[first]));
+      Fail(field.column, fmt::format("{} is '{}'{}; expected a finite number", FieldName(layout, index), field.text,
+                                     spelt ? "" : ", too large for a double (at most 1.8e308 in magnitude)"));
     }
     return *value;
   }
@@ -382,6 +438,9 @@ class Reader {
         case ColumnRole::kWy: w[1] = Number(layout, fields, i); break;
         case ColumnRole::kWz: w[2] = Number(layout, fields, i); break;
       }
+    }
+    if (layout.numbers_after_roles) {
+      for (size_t i = layout.roles.size(); i < fields.size(); ++i) Number(layout, fields, i);
     }
     if (layout.euler) {
       const Eigen::Quaterniond rotation = QuaternionFromRollPitchYaw(euler[0], euler[1], euler[2]);
@@ -462,17 +521,40 @@ bool IsIntegerNanoseconds(std::string_view text) {
   return true;
 }
 
+// Where a header row disagrees with TUM's columns (t x y z qx qy qz qw, then vx vy vz for tumv):
+// its first name must start with 't' (t, ts, time, timestamp) and each later one end in the axis of
+// its column (x, px, tx, qx, q_x, "qx", ...). Returns the index of the first name that does not, or
+// nullopt. A header says the file has its own layout: an IMU log `t gyro_x gyro_y gyro_z acc_x acc_y
+// acc_z thrust` or a w-first `t x y z qw qx qy qz` also has 8 columns, and reading them as TUM
+// would give wrong rotations without a word, so detection assumes TUM only when the names agree.
+std::optional<size_t> FirstNameNotInTumOrder(const std::vector<Field>& header) {
+  constexpr std::string_view kAxes = "txyzxyzwxyzxyz";  // the letter each column's name must show
+  for (size_t i = 0; i < header.size(); ++i) {
+    std::string_view name = header[i].text;
+    while (!name.empty() && (name.front() == '"' || name.front() == '\'')) name.remove_prefix(1);
+    while (!name.empty() && (name.back() == '"' || name.back() == '\'')) name.remove_suffix(1);
+    if (i >= kAxes.size() || name.empty()) return i;
+    const auto letter = static_cast<unsigned char>(i == 0 ? name.front() : name.back());
+    if (std::tolower(letter) != kAxes[i]) return i;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 Format DetectFormat(const std::string& path, std::string_view content) {
   LineScanner scanner(content);
   std::vector<Field> fields;
   bool header = false;
+  std::vector<Field> header_fields;
+  int64_t header_line = 0;
   while (scanner.Next()) {
     const char separator = scanner.line().find(',') != std::string_view::npos ? ',' : ' ';
     scanner.Split(separator, &fields);
     if (!header && IsHeaderRow(fields)) {
       header = true;
+      header_fields = fields;
+      header_line = scanner.line_number();
       continue;
     }
     const size_t count = fields.size();
@@ -488,14 +570,36 @@ Format DetectFormat(const std::string& path, std::string_view content) {
                                    "Use --format csv --columns ... (e.g. t_ns,px,py,pz,qw,qx,qy,qz)",
                                    count, header ? " after a header row" : ""));
     }
-    if (!header) {
-      if (count == 8) return Format::kTum;
-      if (count == 11) return Format::kTumV;
-      if (count == 12) return Format::kKitti;
+    if (count == 8 || count == 11 || count == 14) {
+      const Format format = count == 8 ? Format::kTum : Format::kTumV;
+      if (!header) return format;
+      // The tum/tumv readers skip a header row, so detection accepts one that names TUM's columns.
+      const std::optional<size_t> wrong = FirstNameNotInTumOrder(header_fields);
+      if (!wrong && header_fields.size() == count) return format;
+      const std::string columns = count == 8    ? "t x y z qx qy qz qw"
+                                  : count == 11 ? "t x y z qx qy qz qw vx vy vz"
+                                                : "t x y z qx qy qz qw vx vy vz wx wy wz";
+      const std::string axes = count == 8 ? "x y z x y z w" : count == 11 ? "x y z x y z w x y z" : "x y z x y z w x y z x y z";
+      const bool named = wrong && *wrong < count;
+      throw InputError(path, header_line, named ? header_fields[*wrong].column : 1,
+                       fmt::format("cannot detect the format: {} space-separated fields after a header row that does "
+                                   "not name {}'s columns ({}: a time first, then names ending in {}); {}. Use "
+                                   "--format {} if the columns are in that order, else --format csv --columns ...",
+                                   count, ToString(format), columns, axes,
+                                   named ? fmt::format("its field {} is '{}'", *wrong + 1, header_fields[*wrong].text)
+                                         : fmt::format("it has {} names", header_fields.size()),
+                                   ToString(format)));
+    }
+    if (count == 12) {
+      if (!header) return Format::kKitti;
+      throw InputError(path, scanner.line_number(), 1,
+                       "cannot detect the format: 12 space-separated fields after a header row; KITTI files have no "
+                       "header. Use --format kitti if this is one, else --format csv --columns ...");
     }
     throw InputError(path, scanner.line_number(), 1,
                      fmt::format("cannot detect the format: {} space-separated fields{}; expected 8 (tum: t x y z qx "
-                                 "qy qz qw), 11 (tumv: ... vx vy vz) or 12 (kitti). Use --format csv --columns ...",
+                                 "qy qz qw), 11 (tumv: ... vx vy vz), 12 (kitti) or 14 (tumv: ... vx vy vz wx wy wz). Use --format csv "
+                                 "--columns ...",
                                  count, header ? " after a header row" : ""));
   }
   throw InputError(path, scanner.line_number() + 1, 1,

@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include <fmt/compile.h>
 #include <fmt/format.h>
 
 #include "cheval/common/error.h"
@@ -44,11 +45,16 @@ std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
       }
       for (Eigen::Index i = 0; i < trajectory.size(); ++i) {
         const Eigen::Vector4d q = QuaternionAsStored(trajectory, i);
-        fmt::format_to(it, "{} {} {} {} {} {} {} {}", FormatSeconds(trajectory.stamps_ns()[i]), p(0, i), p(1, i),
-                       p(2, i), q[0], q[1], q[2], q[3]);
+        // Compiled format strings: parsing "{}" at run time per value cost as much as the digits.
+        fmt::format_to(it, FMT_COMPILE("{} {} {} {} {} {} {} {}"), FormatSeconds(trajectory.stamps_ns()[i]), p(0, i),
+                       p(1, i), p(2, i), q[0], q[1], q[2], q[3]);
         if (format == Format::kTumV) {
           const auto v = trajectory.velocities().col(i);
-          fmt::format_to(it, " {} {} {}", v[0], v[1], v[2]);
+          fmt::format_to(it, FMT_COMPILE(" {} {} {}"), v[0], v[1], v[2]);
+          if (trajectory.has_angular_velocity()) {
+            const auto w = trajectory.angular_velocities().col(i);
+            fmt::format_to(it, FMT_COMPILE(" {} {} {}"), w[0], w[1], w[2]);
+          }
         }
         out.push_back('\n');
       }
@@ -64,11 +70,11 @@ std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
       out.push_back('\n');
       for (Eigen::Index i = 0; i < trajectory.size(); ++i) {
         const Eigen::Vector4d q = QuaternionAsStored(trajectory, i);
-        fmt::format_to(it, "{},{},{},{},{},{},{},{}", trajectory.stamps_ns()[i], p(0, i), p(1, i), p(2, i), q[3],
+        fmt::format_to(it, FMT_COMPILE("{},{},{},{},{},{},{},{}"), trajectory.stamps_ns()[i], p(0, i), p(1, i), p(2, i), q[3],
                        q[0], q[1], q[2]);
         if (trajectory.has_velocity()) {
           const auto v = trajectory.velocities().col(i);
-          fmt::format_to(it, ",{},{},{}", v[0], v[1], v[2]);
+          fmt::format_to(it, FMT_COMPILE(",{},{},{}"), v[0], v[1], v[2]);
         }
         out.push_back('\n');
       }
@@ -78,7 +84,7 @@ std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
       RequireOrientation(trajectory, format);
       for (Eigen::Index i = 0; i < trajectory.size(); ++i) {
         const Eigen::Matrix3d R = trajectory.Rotation(i);
-        fmt::format_to(it, "{} {} {} {} {} {} {} {} {} {} {} {}\n", R(0, 0), R(0, 1), R(0, 2), p(0, i), R(1, 0),
+        fmt::format_to(it, FMT_COMPILE("{} {} {} {} {} {} {} {} {} {} {} {}\n"), R(0, 0), R(0, 1), R(0, 2), p(0, i), R(1, 0),
                        R(1, 1), R(1, 2), p(1, i), R(2, 0), R(2, 1), R(2, 2), p(2, i));
       }
       break;
