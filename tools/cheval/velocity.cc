@@ -23,6 +23,7 @@ struct VelocityFlags {
   double window_s = 0.0;
   std::string at_path;
   std::string json_path;
+  bool angular = false;
   InputFlags format;
 };
 
@@ -43,6 +44,7 @@ std::vector<int64_t> ReadQueryStamps(const std::string& path) {
 eval::VelocityOptions ToOptions(const VelocityFlags& flags, const traj::TrajectoryView& trajectory) {
   eval::VelocityOptions options;
   options.method = *eval::VelocityMethodFromString(flags.method);
+  options.angular = flags.angular;
   if (flags.degree == "auto" || flags.degree == "cv") {
     options.curve.degree_method = cheb::DegreeMethod::kCrossValidation;
   } else if (flags.degree == "chop") {
@@ -77,10 +79,13 @@ eval::VelocityOptions ToOptions(const VelocityFlags& flags, const traj::Trajecto
   return options;
 }
 
-std::string FormatOutput(const traj::TrajectoryView& input, std::span<const int64_t> stamps, bool own_stamps,
-                         const eval::VelocityEstimate& estimate) {
-  fmt::memory_buffer out;
-  auto it = std::back_inserter(out);
+// The output trajectory: positions and orientation as read at the input's own stamps, or the
+// fitted ones at --at stamps; the velocities; the angular velocities with --angular.
+traj::Trajectory MakeOutput(const traj::TrajectoryView& input, std::span<const int64_t> stamps, bool own_stamps,
+                            const eval::VelocityEstimate& estimate) {
+  traj::Trajectory out(traj::Channels{traj::OrientationKind::kQuaternion, true, estimate.angular_velocities.cols() > 0,
+                                      true});
+  out.Reserve(static_cast<Eigen::Index>(stamps.size()));
   for (size_t i = 0; i < stamps.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
     Eigen::Vector3d position;
@@ -94,7 +99,9 @@ std::string FormatOutput(const traj::TrajectoryView& input, std::span<const int6
       }
     } else {
       position = estimate.positions.col(k);
-      if (input.has_orientation()) {
+      if (!estimate.orientations.empty()) {
+        q = estimate.orientations[i].coeffs();  // the fitted orientation curve
+      } else if (input.has_orientation()) {
         // Slerp between the input's neighbouring orientations (stamps sorted by the caller's file).
         const auto s = input.stamps_ns();
         const auto upper = std::upper_bound(s.begin(), s.end(), stamps[i]) - s.begin();
@@ -104,11 +111,12 @@ std::string FormatOutput(const traj::TrajectoryView& input, std::span<const int6
         q = input.UnitQuaternion(j0).slerp(f, input.UnitQuaternion(j1)).coeffs();
       }
     }
-    const auto vel = estimate.velocities.col(k);
-    fmt::format_to(it, "{} {} {} {} {} {} {} {} {} {} {}\n", traj::FormatSeconds(stamps[i]), position[0], position[1],
-                   position[2], q[0], q[1], q[2], q[3], vel[0], vel[1], vel[2]);
+    const Eigen::Vector3d v = estimate.velocities.col(k);
+    Eigen::Vector3d w = Eigen::Vector3d::Zero();
+    if (estimate.angular_velocities.cols() > 0) w = estimate.angular_velocities.col(k);
+    out.Append(stamps[i], position.data(), q.data(), v.data(), w.data());
   }
-  return fmt::to_string(out);
+  return out;
 }
 
 }  // namespace
@@ -120,7 +128,7 @@ void RegisterVelocity(CLI::App& app, Action* action) {
                   "Savitzky-Golay)");
   command->add_option("input", flags->input, "Trajectory file (positions are used)")->required();
   command->add_option("-o,--output", flags->output,
-                      "Write TUM + velocity (t x y z qx qy qz qw vx vy vz), orientation as read");
+                      "Write TUM + velocity (t x y z qx qy qz qw vx vy vz [wx wy wz]), orientation as read");
   command->add_option("--method", flags->method, "Velocity method")
       ->check(CLI::IsMember({"chebyshev", "central", "savgol"}))
       ->capture_default_str();
@@ -133,6 +141,8 @@ void RegisterVelocity(CLI::App& app, Action* action) {
                       "(default 21 samples)");
   command->add_option("--at", flags->at_path,
                       "Evaluate at these stamps: a file of one stamp (s) per line, or a trajectory file");
+  command->add_flag("--angular", flags->angular,
+                    "Also body angular velocity from the orientations, appended as wx wy wz (rad/s)");
   command->add_option("--json", flags->json_path, "Write what was done as JSON");
   AddInputFlags(command, &flags->format);
   command->callback([flags, action] {
@@ -148,7 +158,10 @@ void RegisterVelocity(CLI::App& app, Action* action) {
       const eval::VelocityEstimate estimate =
           eval::EstimateVelocity(view, options, own ? std::nullopt : std::optional<std::span<const int64_t>>(at));
       const std::span<const int64_t> stamps = own ? view.stamps_ns() : std::span<const int64_t>(at);
-      const std::string text = flags->output.empty() ? "" : FormatOutput(view, stamps, own, estimate);
+      const std::string text =
+          flags->output.empty()
+              ? ""
+              : traj::FormatTrajectory(MakeOutput(view, stamps, own, estimate).View(), traj::Format::kTumV);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
       nlohmann::json j;
@@ -175,6 +188,10 @@ void RegisterVelocity(CLI::App& app, Action* action) {
         j["noise_sigma_m"] = std::vector<double>(curve.noise_sigma().data(), curve.noise_sigma().data() + 3);
         j["residual_rmse_m"] = std::vector<double>(curve.residual_rms().data(), curve.residual_rms().data() + 3);
         j["compression_ratio"] = static_cast<double>(3 * view.size()) / static_cast<double>(curve.stored_values());
+      }
+      if (estimate.rotation_curve) {
+        j["angular"] = {{"charts", estimate.rotation_curve->charts().size()},
+                        {"residual_rms_rad", estimate.rotation_curve->residual_rms_rad()}};
       }
       j["seconds"] = seconds;
       if (!view.has_orientation() && !flags->output.empty()) {
