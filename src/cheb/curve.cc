@@ -153,7 +153,7 @@ class WindowFitter {
       resolved = ChopDegrees(high, m, &window.degrees);
       // The chop looks for a plateau by shape, which a short noisy window can hide: when the top
       // third of the coefficients is statistically pure noise, the window is resolved anyway.
-      if (!resolved) resolved = TailIsNoise(high, cholesky->VarianceFactors(top));
+      if (!resolved) resolved = TailIsNoise(high, *cholesky);
       if (cross_validate && (resolved || !may_split)) window.degrees = CrossValidatedDegrees(*folds, top);
     }
     if (!resolved && may_split) return std::nullopt;
@@ -175,15 +175,18 @@ class WindowFitter {
   // coefficient k, Σ (c_k/σ_k)² over the n tail coefficients is χ²(n) for pure noise; the tail is
   // noise when it stays below n + 4·sqrt(2n) (about 4 standard deviations of χ²(n)). Needs a
   // tail of at least 8 coefficients and σ > 0 (noise-free data are left to the chop).
-  bool TailIsNoise(const Eigen::MatrixXd& high, const Eigen::VectorXd& variance_factors) const {
+  bool TailIsNoise(const Eigen::MatrixXd& high, const NestedCholesky& cholesky) const {
     const Eigen::Index top = high.rows() - 1, n = (top + 1) / 3;
     if (n < 8) return false;
+    const Eigen::Index first = top + 1 - n;
+    const Eigen::VectorXd variance_factors =
+        cholesky.VarianceFactors(static_cast<int>(top), static_cast<int>(first));
     const double limit = static_cast<double>(n) + 4.0 * std::sqrt(2.0 * static_cast<double>(n));
     for (Eigen::Index c = 0; c < high.cols(); ++c) {
       if (!(sigma_[c] > 0.0)) return false;
       double chi2 = 0.0;
-      for (Eigen::Index k = top + 1 - n; k <= top; ++k) {
-        chi2 += high(k, c) * high(k, c) / (sigma_[c] * sigma_[c] * variance_factors[k]);
+      for (Eigen::Index k = first; k <= top; ++k) {
+        chi2 += high(k, c) * high(k, c) / (sigma_[c] * sigma_[c] * variance_factors[k - first]);
       }
       if (!(chi2 <= limit)) return false;
     }
@@ -207,7 +210,7 @@ class WindowFitter {
       if (!(cholesky.Condition(top) <= kMaxGramCondition)) return true;
       const Eigen::MatrixXd high = cholesky.Solve(top, normal.rhs);
       std::vector<int> degrees(static_cast<size_t>(z.cols()));
-      return ChopDegrees(high, count, &degrees) || TailIsNoise(high, cholesky.VarianceFactors(top));
+      return ChopDegrees(high, count, &degrees) || TailIsNoise(high, cholesky);
     } catch (const ComputeError&) {
       return true;
     }

@@ -186,11 +186,16 @@ Eigen::MatrixXd NestedCholesky::Solve(int degree, const Eigen::Ref<const Eigen::
   return x;
 }
 
-Eigen::VectorXd NestedCholesky::VarianceFactors(int degree) const {
-  // G⁻¹ = L⁻ᵀL⁻¹, so (G⁻¹)_kk is the squared norm of column k of L⁻¹.
-  const Eigen::MatrixXd inverse = factor_.topLeftCorner(degree + 1, degree + 1)
+Eigen::VectorXd NestedCholesky::VarianceFactors(int degree, int first) const {
+  if (first < 0 || first > degree || degree > this->degree()) {
+    throw std::invalid_argument("NestedCholesky::VarianceFactors: coefficients outside the factorisation");
+  }
+  // G⁻¹ = L⁻ᵀL⁻¹, so (G⁻¹)_kk is the squared norm of column k of L⁻¹; for k >= first that column
+  // is the inverse of the trailing block of L applied to e_k.
+  const int n = degree + 1 - first;
+  const Eigen::MatrixXd inverse = factor_.block(first, first, n, n)
                                       .triangularView<Eigen::Lower>()
-                                      .solve(Eigen::MatrixXd::Identity(degree + 1, degree + 1));
+                                      .solve(Eigen::MatrixXd::Identity(n, n));
   return inverse.colwise().squaredNorm().transpose();
 }
 

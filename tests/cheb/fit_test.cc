@@ -65,6 +65,10 @@ TEST(NestedCholesky, LeadingBlocksGiveEveryLowerDegreeFit) {
               1e-12 * inverse.diagonal().cwiseAbs().maxCoeff())
         << degree;
     EXPECT_GE(cholesky.Condition(degree), 1.0);
+    const int first = degree / 2;
+    EXPECT_LE((cholesky.VarianceFactors(degree, first) - inverse.diagonal().tail(degree + 1 - first)).cwiseAbs().maxCoeff(),
+              1e-12 * inverse.diagonal().cwiseAbs().maxCoeff())
+        << degree;
   }
   EXPECT_THROW(cholesky.Solve(top + 1, equations.rhs), std::invalid_argument);
 }

@@ -74,7 +74,10 @@ class NestedCholesky {
   Eigen::MatrixXd Solve(int degree, const Eigen::Ref<const Eigen::MatrixXd>& rhs) const;
   /// diag(G⁻¹) of the degree-`degree` block: with unit weights and white noise of standard
   /// deviation σ, coefficient k of that fit has standard deviation σ·sqrt(factor_k).
-  Eigen::VectorXd VarianceFactors(int degree) const;
+  Eigen::VectorXd VarianceFactors(int degree) const { return VarianceFactors(degree, 0); }
+  /// The same for coefficients first..degree only (degree − first + 1 values): column k of L⁻¹
+  /// is zero above row k, so only the trailing block of L is inverted.
+  Eigen::VectorXd VarianceFactors(int degree, int first) const;
 
  private:
   Eigen::MatrixXd factor_;  // lower triangular L
