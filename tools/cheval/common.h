@@ -31,5 +31,8 @@ void RegisterInfo(CLI::App& app, Action* action);
 void RegisterConvert(CLI::App& app, Action* action);
 void RegisterSim(CLI::App& app, Action* action);
 void RegisterVelocity(CLI::App& app, Action* action);
+void RegisterApe(CLI::App& app, Action* action);
+void RegisterRpe(CLI::App& app, Action* action);
+void RegisterAse(CLI::App& app, Action* action);
 
 }  // namespace cheval::cli

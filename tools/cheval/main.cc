@@ -19,6 +19,9 @@ int main(int argc, char** argv) {
   cheval::cli::RegisterConvert(app, &action);
   cheval::cli::RegisterSim(app, &action);
   cheval::cli::RegisterVelocity(app, &action);
+  cheval::cli::RegisterApe(app, &action);
+  cheval::cli::RegisterRpe(app, &action);
+  cheval::cli::RegisterAse(app, &action);
 
   auto fail = [](ExitCode code, const std::string& message) {
     std::fprintf(stderr, "%s\n", message.c_str());

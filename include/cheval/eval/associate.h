@@ -1,0 +1,68 @@
+#pragma once
+/// \file
+/// Time association of a reference and an estimate: which reference pose each estimate pose is
+/// compared with. The semantics are evo's (`evo.core.sync.associate_trajectories`, v1.36.5;
+/// METRICS.md §2), computed in O((n + m) log m) instead of evo's O(n·m) brute force:
+///
+/// - iterate over the **shorter** list (the estimate when both have the same length) in file order;
+/// - for each of its stamps s take the **nearest** stamp of the other list (reference stamps minus the
+///   offset, or estimate stamps plus the offset), the **first** in file order on exact ties;
+/// - keep the pair when |dt| <= max_diff (**inclusive**).
+///
+/// The result is not one-to-one: a pose of the longer list may be used by several pairs. Unsorted and
+/// duplicated stamps give exactly the pairs of the brute force. Stamps are int64 nanoseconds and all
+/// differences are exact (evo subtracts float seconds, whose rounding at 1.4e9 s is ~2e-7 s; only an
+/// exact midpoint tie or a |dt| within 2e-7 s of max_diff can be decided differently).
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "cheval/traj/trajectory.h"
+
+namespace cheval::eval {
+
+/// Options of the association; the defaults are evo's (`--t_max_diff 0.01`, `--t_offset 0`).
+struct AssociationOptions {
+  /// Largest accepted |t_ref - (t_est + offset)|, nanoseconds (inclusive). Must be >= 0.
+  int64_t max_diff_ns = 10'000'000;
+  /// Added to every estimate stamp: est_time + offset ≈ ref_time (evo's `--t_offset`), nanoseconds.
+  int64_t offset_ns = 0;
+};
+
+/// Pairs of associated poses: pair k compares reference pose `ref[k]` with estimate pose `est[k]`.
+struct Association {
+  std::vector<Eigen::Index> ref;
+  std::vector<Eigen::Index> est;
+  /// True when poses were paired by index (KITTI files without stamps), not by time.
+  bool by_index = false;
+
+  /// Number of pairs.
+  Eigen::Index size() const { return static_cast<Eigen::Index>(est.size()); }
+  bool empty() const { return est.empty(); }
+};
+
+/// Associates two lists of stamps with evo's rule (see the file comment). Any order, duplicates
+/// allowed. Returns the pairs in the order of the shorter list (possibly none). Throws UsageError
+/// for a negative max_diff.
+Association AssociateStamps(std::span<const int64_t> ref_stamps_ns, std::span<const int64_t> est_stamps_ns,
+                            const AssociationOptions& options = {});
+
+/// Associates two trajectories. When either has no stamps (KITTI without a times file), pose i is
+/// paired with pose i, as evo's `kitti` mode does, and the lengths must agree. Throws ComputeError
+/// when the lengths differ in that case, and when no pair is found: the message gives both stamp
+/// ranges and suggests --t-offset or checking the stamp units.
+Association Associate(const traj::TrajectoryView& ref, const traj::TrajectoryView& est,
+                      const AssociationOptions& options = {});
+
+/// The stamps of the poses of `association` on one side, in pair order.
+std::vector<int64_t> PairedStamps(std::span<const int64_t> stamps_ns, std::span<const Eigen::Index> indices);
+
+/// Converts seconds (as given on a command line) to nanoseconds, rounding to the nearest; throws
+/// UsageError naming `what` if the value is not finite or does not fit in int64.
+int64_t SecondsToNanoseconds(double seconds, const std::string& what);
+
+}  // namespace cheval::eval

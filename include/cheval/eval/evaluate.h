@@ -1,0 +1,100 @@
+#pragma once
+/// \file
+/// One evaluation end to end, the data flow of DESIGN.md: two trajectories -> association (index
+/// pairs) -> reference velocity if the metric needs it -> alignment (a similarity applied to R, p, v)
+/// -> per-pair errors -> statistics. The CLI's `ape`, `rpe` and `ase` are this call plus printing.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cheval/eval/align.h"
+#include "cheval/eval/associate.h"
+#include "cheval/eval/metrics.h"
+#include "cheval/eval/statistics.h"
+#include "cheval/eval/velocity.h"
+
+namespace cheval::eval {
+
+/// The metric of an evaluation.
+enum class MetricKind { kApe, kRpe, kAse };
+/// "ape", "rpe", "ase".
+std::string_view ToString(MetricKind metric);
+
+/// Where the reference velocity of the ASE comes from.
+enum class ReferenceVelocitySource {
+  kAuto,       ///< its own velocity columns if it has them, else kChebyshev (C-ASE)
+  kGiven,      ///< its own velocity columns (ComputeError without them)
+  kChebyshev,  ///< the derivative of a windowed Chebyshev fit of its positions (C-ASE)
+  kCentral,    ///< central differences of its positions (a baseline)
+};
+/// "auto", "given", "chebyshev", "central".
+std::string_view ToString(ReferenceVelocitySource source);
+std::optional<ReferenceVelocitySource> ReferenceVelocitySourceFromString(std::string_view name);
+
+/// Everything an evaluation needs besides the two trajectories.
+struct EvaluationOptions {
+  MetricKind metric = MetricKind::kApe;
+  AssociationOptions association;
+  /// Instead of pairing each estimate pose with the nearest reference pose, evaluate the reference
+  /// at the exact estimate stamps (plus the association offset): positions and velocity from a Chebyshev curve fitted to its
+  /// positions (options `velocity.curve`), orientation by slerp between the two reference poses
+  /// around the stamp. Estimate poses outside the curve (before, after, or inside a gap of the
+  /// reference) are left out. Needs reference stamps in non-decreasing order.
+  bool continuous_reference = false;
+  AlignmentOptions alignment;
+  /// APE and RPE: the pose relation; RPE: δ, its unit and all-pairs mode (rpe.relation is ignored).
+  PoseRelation relation = PoseRelation::kTranslation;
+  RpeOptions rpe;
+  /// RPE: also compute the KITTI-style drift over 100..800 m.
+  bool kitti_drift = false;
+  /// ASE: the reference velocity, and the options of EstimateVelocity when it is derived.
+  ReferenceVelocitySource reference_velocity = ReferenceVelocitySource::kAuto;
+  VelocityOptions velocity;
+  /// ASE: the estimate's velocity columns are body-frame (rotated by its own orientation).
+  bool estimate_velocity_body_frame = false;
+  /// ASE without velocity (rotation + position only) instead of an error when velocity is missing.
+  bool pose_only = false;
+};
+
+/// The result of Evaluate: what was paired, how it was aligned, the errors and their statistics.
+struct EvaluationResult {
+  MetricKind metric = MetricKind::kApe;
+  /// The pairs. With continuous_reference, `ref[k]` indexes the reference evaluated at the estimate
+  /// stamps (`continuous_reference`), not the reference file.
+  Association association;
+  std::optional<traj::Trajectory> continuous_reference;
+  AlignmentResult alignment;
+  /// evo-style title, one line per item, e.g. "APE w.r.t. translation part (m)\n(not aligned)".
+  std::string title;
+  /// Name of the metric's relation ("trans_part", ... ; for ASE "state", "position+velocity",
+  /// "rotation+position") and unit of the errors ("m", "deg", "rad", "" for unit-less).
+  std::string relation;
+  std::string unit;
+  /// One error per pair (APE, ASE) or per index pair (RPE), and their statistics.
+  std::vector<double> errors;
+  ErrorStatistics stats;
+  /// Estimate stamp of each error (RPE: of its first pose; stamps_end: of its second).
+  std::vector<int64_t> stamps_ns;
+  std::vector<int64_t> stamps_end_ns;
+  /// RPE: the index pairs (positions in the association).
+  std::vector<IndexPair> rpe_pairs;
+  /// ASE: the parts and their statistics (rotation empty for a position-only reference, velocity
+  /// empty for a pose-only ASE), and where the reference velocity came from ("given", "chebyshev",
+  /// "central", or "none").
+  std::optional<AseErrors> ase;
+  ErrorStatistics rotation_stats, position_stats, velocity_stats;
+  std::string velocity_source;
+  /// RPE with kitti_drift.
+  std::optional<DriftResult> drift;
+};
+
+/// Evaluates `est` against `ref`. Throws UsageError for bad options and ComputeError when the
+/// evaluation is impossible (no pairs, degenerate alignment, missing orientation or velocity), with a
+/// message saying what to change.
+EvaluationResult Evaluate(const traj::TrajectoryView& ref, const traj::TrajectoryView& est,
+                          const EvaluationOptions& options);
+
+}  // namespace cheval::eval

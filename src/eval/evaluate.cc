@@ -1,0 +1,230 @@
+#include "cheval/eval/evaluate.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "cheval/cheb/curve.h"
+#include "cheval/common/error.h"
+#include "enum_names.h"
+
+namespace cheval::eval {
+namespace {
+
+constexpr detail::NameTable<MetricKind, 3> kMetricNames{{
+    {MetricKind::kApe, {"ape"}}, {MetricKind::kRpe, {"rpe"}}, {MetricKind::kAse, {"ase"}}}};
+constexpr detail::NameTable<ReferenceVelocitySource, 4> kVelocitySourceNames{{
+    {ReferenceVelocitySource::kAuto, {"auto"}},
+    {ReferenceVelocitySource::kGiven, {"given"}},
+    {ReferenceVelocitySource::kChebyshev, {"chebyshev"}},
+    {ReferenceVelocitySource::kCentral, {"central"}},
+}};
+
+// evo prints δ as Python does: an int for frames, a float ("10.0") otherwise.
+std::string DeltaText(double delta, DeltaUnit unit) {
+  if (unit == DeltaUnit::kFrames) return fmt::format("{}", static_cast<long long>(delta));
+  return delta == std::floor(delta) && std::abs(delta) < 1e15 ? fmt::format("{:.1f}", delta) : fmt::format("{}", delta);
+}
+
+std::string AlignmentLine(const AlignmentResult& alignment, Eigen::Index pairs) {
+  std::string line(AlignmentTitle(alignment.method));
+  if (alignment.method != AlignmentMethod::kNone && alignment.method != AlignmentMethod::kOrigin &&
+      alignment.pairs_used < pairs) {
+    line += fmt::format(" (aligned poses: {})", alignment.pairs_used);
+  }
+  return line;
+}
+
+std::string UnitText(std::string_view unit) { return unit.empty() ? "unit-less" : std::string(unit); }
+
+// Sets the reference velocity of the ASE from the chosen source; returns the source's name.
+std::string ProvideReferenceVelocity(PairedStates& pairs, const EvaluationOptions& options) {
+  ReferenceVelocitySource source = options.reference_velocity;
+  const traj::TrajectoryView& ref = pairs.reference();
+  if (source == ReferenceVelocitySource::kAuto) {
+    source = ref.has_velocity() ? ReferenceVelocitySource::kGiven : ReferenceVelocitySource::kChebyshev;
+  }
+  switch (source) {
+    case ReferenceVelocitySource::kAuto:
+    case ReferenceVelocitySource::kGiven:
+      if (!ref.has_velocity()) {
+        throw ComputeError("--gt-velocity given: the reference has no velocity columns (use --gt-velocity chebyshev "
+                           "to derive it from its positions)");
+      }
+      return "given";
+    case ReferenceVelocitySource::kChebyshev: {
+      if (!ref.has_stamps()) throw ComputeError("a reference velocity from positions needs stamps (KITTI times)");
+      VelocityOptions velocity = options.velocity;
+      velocity.method = VelocityMethod::kChebyshev;
+      const std::vector<int64_t> at = PairedStamps(ref.stamps_ns(), pairs.association().ref);
+      pairs.SetReferenceVelocities(EstimateVelocity(ref, velocity, std::span<const int64_t>(at)).velocities);
+      return "chebyshev";
+    }
+    case ReferenceVelocitySource::kCentral: {
+      if (!ref.has_stamps()) throw ComputeError("a reference velocity from positions needs stamps (KITTI times)");
+      VelocityOptions velocity = options.velocity;
+      velocity.method = VelocityMethod::kCentral;
+      const Eigen::Matrix3Xd all = EstimateVelocity(ref, velocity).velocities;
+      Eigen::Matrix3Xd paired(3, pairs.size());
+      for (Eigen::Index k = 0; k < pairs.size(); ++k) paired.col(k) = all.col(pairs.association().ref[static_cast<size_t>(k)]);
+      pairs.SetReferenceVelocities(std::move(paired));
+      return "central";
+    }
+  }
+  return "none";
+}
+
+// The reference evaluated at the estimate stamps inside its fitted curve (see EvaluationOptions::
+// continuous_reference), with the pairs (k, estimate index) in estimate file order.
+traj::Trajectory ContinuousReference(const traj::TrajectoryView& ref, const traj::TrajectoryView& est,
+                                     const cheb::CurveOptions& curve_options, int64_t offset_ns,
+                                     Association* association) {
+  const std::span<const int64_t> ref_stamps = ref.stamps_ns();
+  if (!ref.has_stamps() || !est.has_stamps()) throw ComputeError("--association continuous needs stamps in both files");
+  if (!std::is_sorted(ref_stamps.begin(), ref_stamps.end())) {
+    throw ComputeError("--association continuous needs the reference's stamps in increasing order");
+  }
+  const Eigen::MatrixXd positions = ref.positions().transpose();
+  const cheb::Curve curve = cheb::FitCurve(ref_stamps, positions, curve_options);
+  // Estimate stamps inside a segment of the curve (not before, after, or in a gap of the reference).
+  std::vector<int64_t> stamps;
+  association->ref.clear();
+  association->est.clear();
+  for (Eigen::Index e = 0; e < est.size(); ++e) {
+    const int64_t stamp = est.stamps_ns()[e] + offset_ns;  // est + offset = ref
+    const double t = static_cast<double>(stamp - curve.origin_ns()) * 1e-9;
+    const bool inside = std::any_of(curve.segments().begin(), curve.segments().end(),
+                                    [&](const cheb::CurveSegment& s) { return s.begin <= t && t <= s.end; });
+    if (!inside) continue;
+    association->ref.push_back(static_cast<Eigen::Index>(stamps.size()));
+    association->est.push_back(e);
+    stamps.push_back(stamp);
+  }
+  if (stamps.empty()) {
+    throw ComputeError("--association continuous: no estimate stamp lies within the time covered by the reference");
+  }
+  Eigen::MatrixXd values, derivatives;
+  curve.EvaluateMany(stamps, 1, &values, &derivatives);
+  traj::Channels channels;
+  channels.orientation = ref.has_orientation() ? traj::OrientationKind::kQuaternion : traj::OrientationKind::kNone;
+  channels.velocity = true;
+  traj::Trajectory out(channels);
+  out.Reserve(static_cast<Eigen::Index>(stamps.size()));
+  for (size_t k = 0; k < stamps.size(); ++k) {
+    Eigen::Vector4d q(0, 0, 0, 1);
+    if (ref.has_orientation()) {
+      // Slerp between the reference poses around the stamp.
+      const auto upper = std::upper_bound(ref_stamps.begin(), ref_stamps.end(), stamps[k]) - ref_stamps.begin();
+      const Eigen::Index j1 = std::clamp<Eigen::Index>(upper, 1, ref.size() - 1), j0 = j1 - 1;
+      const double span = static_cast<double>(ref_stamps[j1] - ref_stamps[j0]);
+      const double f = span > 0 ? std::clamp(static_cast<double>(stamps[k] - ref_stamps[j0]) / span, 0.0, 1.0) : 0.0;
+      q = ref.UnitQuaternion(j0).slerp(f, ref.UnitQuaternion(j1)).coeffs();
+    }
+    const Eigen::Vector3d p = values.row(static_cast<Eigen::Index>(k)).transpose();
+    const Eigen::Vector3d v = derivatives.row(static_cast<Eigen::Index>(k)).transpose();
+    out.Append(stamps[k], p.data(), q.data(), v.data());
+  }
+  return out;
+}
+
+void EvaluateAse(PairedStates& pairs, const EvaluationOptions& options, EvaluationResult* result) {
+  const AseErrors ase = AseErrorsOf(pairs, !options.pose_only);
+  result->errors = ase.total;
+  result->rotation_stats = ComputeStatistics(ase.rotation);
+  result->position_stats = ComputeStatistics(ase.position);
+  result->velocity_stats = ComputeStatistics(ase.velocity);
+  if (ase.has_rotation && ase.has_velocity) {
+    result->relation = "state";
+    result->title = "ASE on SE_2(3): rotation + position + velocity (unit-less: mixes rad-like, m and m/s)";
+  } else if (ase.has_velocity) {
+    result->relation = "position+velocity";
+    result->title = "ASE position + velocity state error (reference without orientation; mixes m and m/s)";
+  } else {
+    result->relation = "rotation+position";
+    result->title = "ASE pose-only: rotation + position (no velocity; mixes rad-like and m)";
+  }
+  result->title += fmt::format("\n(reference velocity: {})", result->velocity_source);
+  result->ase = ase;
+}
+
+}  // namespace
+
+std::string_view ToString(MetricKind metric) { return detail::TextOf(kMetricNames, metric); }
+std::string_view ToString(ReferenceVelocitySource source) { return detail::TextOf(kVelocitySourceNames, source); }
+std::optional<ReferenceVelocitySource> ReferenceVelocitySourceFromString(std::string_view name) {
+  return detail::ValueOf(kVelocitySourceNames, name);
+}
+
+EvaluationResult Evaluate(const traj::TrajectoryView& ref, const traj::TrajectoryView& est,
+                          const EvaluationOptions& options) {
+  EvaluationResult result;
+  result.metric = options.metric;
+  if (options.continuous_reference) {
+    if (options.reference_velocity == ReferenceVelocitySource::kGiven ||
+        options.reference_velocity == ReferenceVelocitySource::kCentral) {
+      throw UsageError("--association continuous takes the reference velocity from its Chebyshev curve: use "
+                       "--gt-velocity auto or chebyshev");
+    }
+    result.continuous_reference =
+        ContinuousReference(ref, est, options.velocity.curve, options.association.offset_ns, &result.association);
+  } else {
+    result.association = Associate(ref, est, options.association);
+  }
+  const traj::TrajectoryView reference = options.continuous_reference ? result.continuous_reference->View() : ref;
+  PairedStates pairs(reference, est, result.association);
+  if (options.metric == MetricKind::kAse) {
+    result.velocity_source = "none";
+    if (!options.pose_only) {
+      if (!est.has_velocity()) {
+        throw ComputeError("ASE needs the estimate's velocity and it has none: give a file with velocity columns "
+                           "(tumv, euroc, vins, or csv with vx,vy,vz), or ask for the pose-only ASE with --pose-only");
+      }
+      pairs.SetEstimateVelocityInBodyFrame(options.estimate_velocity_body_frame);
+      result.velocity_source =
+          options.continuous_reference ? "chebyshev (continuous)" : ProvideReferenceVelocity(pairs, options);
+    }
+  }
+  result.alignment = ComputeAlignment(pairs, options.alignment);
+  pairs.SetAlignment(result.alignment.transform);
+  const std::string alignment_line = AlignmentLine(result.alignment, pairs.size());
+
+  switch (options.metric) {
+    case MetricKind::kApe: {
+      result.relation = ToString(options.relation);
+      result.unit = RelationUnit(options.relation);
+      result.errors = ApeErrors(pairs, options.relation);
+      result.title = fmt::format("APE w.r.t. {} ({})", RelationDescription(options.relation), UnitText(result.unit));
+      result.stamps_ns = PairedStamps(est.stamps_ns(), result.association.est);
+      break;
+    }
+    case MetricKind::kRpe: {
+      RpeOptions rpe = options.rpe;
+      rpe.relation = options.relation;
+      result.relation = ToString(options.relation);
+      result.unit = RelationUnit(options.relation);
+      result.rpe_pairs = RpeIndexPairs(pairs, rpe);
+      result.errors = RpeErrors(pairs, result.rpe_pairs, options.relation);
+      result.title = fmt::format("RPE w.r.t. {} ({})\nfor delta = {} ({}) using {} pairs",
+                                 RelationDescription(options.relation), UnitText(result.unit),
+                                 DeltaText(rpe.delta, rpe.delta_unit), DeltaUnitLabel(rpe.delta_unit),
+                                 rpe.all_pairs ? "all" : "consecutive");
+      for (const IndexPair& p : result.rpe_pairs) {
+        result.stamps_ns.push_back(pairs.EstimateStamp(p.i));
+        result.stamps_end_ns.push_back(pairs.EstimateStamp(p.j));
+      }
+      if (options.kitti_drift) result.drift = KittiDrift(pairs);
+      break;
+    }
+    case MetricKind::kAse: {
+      EvaluateAse(pairs, options, &result);
+      result.stamps_ns = PairedStamps(est.stamps_ns(), result.association.est);
+      break;
+    }
+  }
+  result.title += "\n" + alignment_line;
+  result.stats = ComputeStatistics(result.errors);
+  return result;
+}
+
+}  // namespace cheval::eval
