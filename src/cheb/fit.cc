@@ -38,7 +38,7 @@ struct Moments {
 // Built twice where the compiler supports function multi-versioning: for x86-64-v3 (AVX2 + FMA)
 // and the baseline; the loader picks the one the CPU runs.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-#define CHEVAL_MULTIVERSION __attribute__((target_clones("arch=x86-64-v3", "default")))
+#define CHEVAL_MULTIVERSION __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #else
 #define CHEVAL_MULTIVERSION
 #endif
@@ -217,7 +217,7 @@ ChebyshevSeries FitLeastSquares(const Eigen::Ref<const Eigen::VectorXd>& t, cons
                               variance_factors);
 }
 
-Eigen::MatrixXd EvaluateSeries(const Eigen::Ref<const Eigen::MatrixXd>& coefficients,
+CHEVAL_MULTIVERSION Eigen::MatrixXd EvaluateSeries(const Eigen::Ref<const Eigen::MatrixXd>& coefficients,
                                const Eigen::Ref<const Eigen::VectorXd>& x) {
   const Eigen::Index n = coefficients.rows() - 1, m = x.size(), d = coefficients.cols();
   Eigen::MatrixXd result(m, d);

@@ -23,6 +23,14 @@ Eigen::Vector4d QuaternionAsStored(const TrajectoryView& trajectory, Eigen::Inde
   return trajectory.UnitQuaternion(i).coeffs();
 }
 
+// FormatSeconds(stamp_ns) appended to `out` without a temporary string (the writers' hot loop).
+void AppendSeconds(fmt::memory_buffer& out, int64_t stamp_ns) {
+  const bool negative = stamp_ns < 0;
+  const uint64_t magnitude = negative ? (~static_cast<uint64_t>(stamp_ns) + 1) : static_cast<uint64_t>(stamp_ns);
+  fmt::format_to(std::back_inserter(out), FMT_COMPILE("{}{}.{:09}"), negative ? "-" : "", magnitude / 1'000'000'000ULL,
+                 magnitude % 1'000'000'000ULL);
+}
+
 void RequireOrientation(const TrajectoryView& trajectory, Format format) {
   if (!trajectory.has_orientation()) {
     throw ComputeError(fmt::format("cannot write {}: the trajectory has no orientation (position only)",
@@ -46,8 +54,8 @@ std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
       for (Eigen::Index i = 0; i < trajectory.size(); ++i) {
         const Eigen::Vector4d q = QuaternionAsStored(trajectory, i);
         // Compiled format strings: parsing "{}" at run time per value cost as much as the digits.
-        fmt::format_to(it, FMT_COMPILE("{} {} {} {} {} {} {} {}"), FormatSeconds(trajectory.stamps_ns()[i]), p(0, i),
-                       p(1, i), p(2, i), q[0], q[1], q[2], q[3]);
+        AppendSeconds(out, trajectory.stamps_ns()[i]);
+        fmt::format_to(it, FMT_COMPILE(" {} {} {} {} {} {} {}"), p(0, i), p(1, i), p(2, i), q[0], q[1], q[2], q[3]);
         if (format == Format::kTumV) {
           const auto v = trajectory.velocities().col(i);
           fmt::format_to(it, FMT_COMPILE(" {} {} {}"), v[0], v[1], v[2]);
