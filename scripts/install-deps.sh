@@ -7,6 +7,7 @@ packages=(
   cmake make g++ pkg-config python3
   libeigen3-dev libceres-dev libcli11-dev nlohmann-json3-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  pybind11-dev python3-dev python3-numpy
 )
 
 missing=()

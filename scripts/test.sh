@@ -7,10 +7,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 build_dir=build
-cmake_args=(-DCMAKE_BUILD_TYPE=Release -DCHEVAL_BUILD_TESTS=ON -DCHEVAL_BUILD_BENCH=ON)
+cmake_args=(-DCMAKE_BUILD_TYPE=Release -DCHEVAL_BUILD_TESTS=ON -DCHEVAL_BUILD_BENCH=ON -DCHEVAL_BUILD_PYTHON=ON)
 if [ "${1:-}" = "--sanitize" ]; then
   build_dir=build-asan
-  cmake_args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DCHEVAL_BUILD_TESTS=ON -DCHEVAL_BUILD_BENCH=OFF -DCHEVAL_SANITIZE=ON)
+  cmake_args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DCHEVAL_BUILD_TESTS=ON -DCHEVAL_BUILD_BENCH=OFF -DCHEVAL_SANITIZE=ON
+              -DCHEVAL_BUILD_PYTHON=OFF)  # Python cannot load an instrumented module without preloading the runtime
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 fi

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "cheval/cheb/curve.h"
 #include "cheval/common/error.h"
@@ -156,6 +157,19 @@ std::optional<ReferenceVelocitySource> ReferenceVelocitySourceFromString(std::st
   return detail::ValueOf(kVelocitySourceNames, name);
 }
 
+void ValidateEvaluationOptions(const EvaluationOptions& options) {
+  if (options.association.max_diff_ns < 0) throw UsageError("--t-max-diff must be >= 0");
+  if (options.alignment.n_align < 0) {
+    throw UsageError(fmt::format("--n-align must be positive, got {}", options.alignment.n_align));
+  }
+  if (options.alignment.n_align > 0 && options.alignment.method == AlignmentMethod::kNone) {
+    throw UsageError("--n-align needs --align (se3, sim3, scale, posyaw or full)");
+  }
+  if (options.pose_only && options.estimate_velocity_body_frame) {
+    throw UsageError("--pose-only ignores velocity: drop --velocity-frame");
+  }
+}
+
 EvaluationResult Evaluate(const traj::TrajectoryView& ref, const traj::TrajectoryView& est,
                           const EvaluationOptions& options) {
   EvaluationResult result;
@@ -225,6 +239,74 @@ EvaluationResult Evaluate(const traj::TrajectoryView& ref, const traj::Trajector
   result.title += "\n" + alignment_line;
   result.stats = ComputeStatistics(result.errors);
   return result;
+}
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+Json StatisticsJson(const ErrorStatistics& s) {
+  return Json{{"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median}, {"std", s.std},
+              {"min", s.min},   {"max", s.max},   {"sse", s.sse},       {"n", s.n}};
+}
+
+std::string_view MetricLabel(MetricKind metric) {
+  return metric == MetricKind::kApe ? "APE" : metric == MetricKind::kRpe ? "RPE" : "ASE";
+}
+
+Json ReportJson(const EvaluationReport& report) {
+  const EvaluationResult& r = report.result;
+  const EvaluationOptions& options = report.options;
+  const Similarity& s = r.alignment.transform;
+  Json j;
+  j["command"] = std::string(ToString(r.metric));
+  j["reference"] = {{"path", report.reference_path}, {"poses", report.reference_poses}};
+  j["estimate"] = {{"path", report.estimate_path}, {"poses", report.estimate_poses}};
+  j["association"] = {{"pairs", r.association.size()}, {"max_diff", report.max_diff_s}, {"offset", report.offset_s}};
+  j["association"]["method"] = r.association.by_index          ? "index"
+                               : options.continuous_reference ? "continuous"
+                                                              : "nearest";
+  Json rotation = Json::array();
+  for (int row = 0; row < 3; ++row) rotation.push_back({s.rotation(row, 0), s.rotation(row, 1), s.rotation(row, 2)});
+  j["alignment"] = {{"method", std::string(ToString(r.alignment.method))},
+                    {"rotation", rotation},
+                    {"translation", {s.translation.x(), s.translation.y(), s.translation.z()}},
+                    {"scale", s.scale}};
+  if (r.alignment.method != AlignmentMethod::kNone) j["alignment"]["pairs_used"] = r.alignment.pairs_used;
+  j["metric"] = {{"name", std::string(MetricLabel(r.metric))}, {"relation", r.relation}, {"unit", UnitText(r.unit)}};
+  if (r.metric == MetricKind::kRpe) {
+    j["metric"]["delta"] = options.rpe.delta;
+    j["metric"]["delta_unit"] = std::string(ToString(options.rpe.delta_unit));
+    j["metric"]["all_pairs"] = options.rpe.all_pairs;
+  }
+  j["stats"] = StatisticsJson(r.stats);
+  if (r.ase) {
+    j["parts"] = Json::object();
+    if (r.ase->has_rotation) j["parts"]["rotation"] = StatisticsJson(r.rotation_stats);
+    j["parts"]["position"] = StatisticsJson(r.position_stats);
+    if (r.ase->has_velocity) j["parts"]["velocity"] = StatisticsJson(r.velocity_stats);
+    j["velocity_source"] = r.velocity_source;
+  }
+  if (r.drift) {
+    Json lengths = Json::array();
+    for (const auto& l : r.drift->lengths) {
+      lengths.push_back({{"length_m", l.length_m}, {"translation_percent", l.translation_percent},
+                         {"rotation_deg_per_m", l.rotation_deg_per_m}, {"segments", l.segments}});
+    }
+    j["drift"] = {{"translation_percent", r.drift->translation_percent},
+                  {"rotation_deg_per_m", r.drift->rotation_deg_per_m},
+                  {"segments", r.drift->segments},
+                  {"lengths", lengths}};
+  }
+  return j;
+}
+
+}  // namespace
+
+std::string EvaluationJson(std::span<const EvaluationReport> reports) {
+  Json all = Json::array();
+  for (const EvaluationReport& report : reports) all.push_back(ReportJson(report));
+  return (all.size() == 1 ? all[0] : all).dump(2) + "\n";
 }
 
 }  // namespace cheval::eval

@@ -15,52 +15,16 @@
 #include <nlohmann/json.hpp>
 
 #include "../support/test_data.h"
+#include "cli_runner.h"
 
 namespace cheval {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-class CliTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("cheval_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  // Runs `cheval ARGS` through the shell with stdout and stderr captured in files.
-  RunResult Cheval(const std::string& args) const {
-    const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
-    const std::string command = std::string(CHEVAL_EXE) + " " + args + " >" + out.string() + " 2>" + err.string();
-    const int status = std::system(command.c_str());
-    RunResult run;
-    run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    run.out = Slurp(out);
-    run.err = Slurp(err);
-    return run;
-  }
-
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-
-  fs::path dir_;
-};
+using cheval::testing::CliTest;
+using cheval::testing::RunResult;
+using cheval::testing::Slurp;
 
 TEST_F(CliTest, SimInfoConvertPipeline) {
   RunResult sim = Cheval("sim motion --kind drone --seed 3 --noise 0.001 --duration 10 --rate 100 -o " + Path("m.txt") +

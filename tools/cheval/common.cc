@@ -39,4 +39,17 @@ void AddInputFlags(CLI::App* command, InputFlags* flags, const std::string& pref
                       "KITTI: file with one stamp (seconds) per pose");
 }
 
+std::vector<int64_t> ReadQueryStamps(const std::string& path) {
+  try {
+    return traj::ReadStampsFile(path);
+  } catch (const InputError& as_stamps) {
+    try {
+      const traj::Trajectory trajectory = traj::ReadTrajectory(path);
+      return {trajectory.stamps_ns().begin(), trajectory.stamps_ns().end()};
+    } catch (const InputError&) {
+      throw as_stamps;  // report the simpler expectation
+    }
+  }
+}
+
 }  // namespace cheval::cli

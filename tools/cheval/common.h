@@ -2,8 +2,10 @@
 // Shared pieces of the CLI faces: input-format options and the registration functions of the
 // subcommands. The CLI holds no logic of its own: it parses flags and calls the library.
 
+#include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -24,6 +26,10 @@ struct InputFlags {
 /// Adds the input flags to `command`; `prefix` allows e.g. --ref-format (empty for --format).
 void AddInputFlags(CLI::App* command, InputFlags* flags, const std::string& prefix = "");
 
+/// Stamps to evaluate at (`--at FILE`): a file of one stamp (seconds) per line, or any trajectory
+/// file (its stamps). InputError with the stamps file's message when it is neither.
+std::vector<int64_t> ReadQueryStamps(const std::string& path);
+
 /// The action a subcommand registers; main runs it after parsing, inside its error mapping.
 using Action = std::function<void()>;
 
@@ -31,8 +37,13 @@ void RegisterInfo(CLI::App& app, Action* action);
 void RegisterConvert(CLI::App& app, Action* action);
 void RegisterSim(CLI::App& app, Action* action);
 void RegisterVelocity(CLI::App& app, Action* action);
+void RegisterCompress(CLI::App& app, Action* action);
+void RegisterSample(CLI::App& app, Action* action);
 void RegisterApe(CLI::App& app, Action* action);
 void RegisterRpe(CLI::App& app, Action* action);
 void RegisterAse(CLI::App& app, Action* action);
+/// `cheval sim quadrotor` (needs RegisterSim first) and `cheval estimate quadrotor` (tools/cheval/quadrotor.cc).
+void RegisterSimQuadrotor(CLI::App& app, Action* action);
+void RegisterEstimate(CLI::App& app, Action* action);
 
 }  // namespace cheval::cli

@@ -5,7 +5,6 @@
 #include <future>
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include "cheval/common/error.h"
 #include "cheval/traj/stamp.h"
@@ -13,14 +12,8 @@
 namespace cheval::cli {
 namespace {
 
-using Json = nlohmann::ordered_json;
-
-// One estimate's evaluation, with what is needed to print it.
-struct Evaluated {
-  std::string path;
-  Eigen::Index poses = 0;
-  eval::EvaluationResult result;
-};
+// One estimate's evaluation, with what is needed to print it and write its JSON.
+using Evaluated = eval::EvaluationReport;
 
 // The read options of one side: its prefixed flags where given, else the ones for both files.
 traj::ReadOptions SideOptions(CLI::App* command, const EvalFlags& flags, const std::string& prefix,
@@ -47,14 +40,9 @@ eval::EvaluationOptions ToOptions(eval::MetricKind metric, const EvalFlags& flag
   options.metric = metric;
   options.association.max_diff_ns = eval::SecondsToNanoseconds(flags.t_max_diff, "--t-max-diff");
   options.association.offset_ns = eval::SecondsToNanoseconds(flags.t_offset, "--t-offset");
-  if (options.association.max_diff_ns < 0) throw UsageError("--t-max-diff must be >= 0");
   options.continuous_reference = flags.association == "continuous";
   options.alignment.method = *eval::AlignmentMethodFromString(flags.align);
-  if (flags.n_align < 0) throw UsageError(fmt::format("--n-align must be positive, got {}", flags.n_align));
   options.alignment.n_align = flags.n_align;
-  if (flags.n_align > 0 && options.alignment.method == eval::AlignmentMethod::kNone) {
-    throw UsageError("--n-align needs --align (se3, sim3, scale, posyaw or full)");
-  }
   options.relation = *eval::PoseRelationFromString(flags.relation);
   options.rpe.delta = flags.delta;
   options.rpe.delta_unit = ParseDeltaUnit(flags.delta_unit);
@@ -63,13 +51,8 @@ eval::EvaluationOptions ToOptions(eval::MetricKind metric, const EvalFlags& flag
   options.reference_velocity = *eval::ReferenceVelocitySourceFromString(flags.gt_velocity);
   options.estimate_velocity_body_frame = flags.velocity_frame == "body";
   options.pose_only = flags.pose_only;
-  if (flags.pose_only && flags.velocity_frame == "body") throw UsageError("--pose-only ignores velocity: drop --velocity-frame");
+  eval::ValidateEvaluationOptions(options);
   return options;
-}
-
-std::string Unit(const eval::EvaluationResult& r) { return r.unit.empty() ? "unit-less" : r.unit; }
-std::string_view MetricName(eval::MetricKind metric) {
-  return metric == eval::MetricKind::kApe ? "APE" : metric == eval::MetricKind::kRpe ? "RPE" : "ASE";
 }
 
 // evo's statistics in its order (sorted by name).
@@ -80,15 +63,15 @@ std::vector<std::pair<std::string, double>> SortedStats(const eval::ErrorStatist
 
 void PrintResult(const EvalFlags& flags, const Evaluated& e, Eigen::Index ref_poses) {
   const eval::EvaluationResult& r = e.result;
-  const Eigen::Index shorter = std::min(ref_poses, e.poses);
+  const Eigen::Index shorter = std::min(ref_poses, e.estimate_poses);
   if (r.association.by_index) {
-    fmt::print("{}: {} pairs (no stamps: pose i with pose i)\n", e.path, r.association.size());
+    fmt::print("{}: {} pairs (no stamps: pose i with pose i)\n", e.estimate_path, r.association.size());
   } else if (r.continuous_reference) {
-    fmt::print("{}: {} of {} estimate stamps inside the reference's Chebyshev curve (continuous reference)\n", e.path,
-               r.association.size(), e.poses);
+    fmt::print("{}: {} of {} estimate stamps inside the reference's Chebyshev curve (continuous reference)\n",
+               e.estimate_path, r.association.size(), e.estimate_poses);
   } else {
-    fmt::print("{}: found {} of max. {} possible matching timestamps (t_max_diff {} s, t_offset {} s)\n", e.path,
-               r.association.size(), shorter, flags.t_max_diff, flags.t_offset);
+    fmt::print("{}: found {} of max. {} possible matching timestamps (t_max_diff {} s, t_offset {} s)\n",
+               e.estimate_path, r.association.size(), shorter, flags.t_max_diff, flags.t_offset);
   }
   fmt::print("{}\n\n", r.title);
   if (!r.ase) {
@@ -119,64 +102,15 @@ void PrintResult(const EvalFlags& flags, const Evaluated& e, Eigen::Index ref_po
 // Several estimates: one table, the paper's Table II form.
 void PrintComparison(const std::vector<Evaluated>& all) {
   size_t width = 8;
-  for (const Evaluated& e : all) width = std::max(width, e.path.size());
+  for (const Evaluated& e : all) width = std::max(width, e.estimate_path.size());
   const eval::EvaluationResult& first = all.front().result;
   fmt::print("{} {}, {} estimates\n", first.title.substr(0, first.title.find('\n')),
              first.title.substr(first.title.rfind('\n') + 1), all.size());
   fmt::print("{:<{}}  {:>12}  {:>12}  {:>12}  {:>8}\n", "estimate", width, "rmse", "std", "median", "pairs");
   for (const Evaluated& e : all) {
-    fmt::print("{:<{}}  {:>12.6f}  {:>12.6f}  {:>12.6f}  {:>8}\n", e.path, width, e.result.stats.rmse,
+    fmt::print("{:<{}}  {:>12.6f}  {:>12.6f}  {:>12.6f}  {:>8}\n", e.estimate_path, width, e.result.stats.rmse,
                e.result.stats.std, e.result.stats.median, e.result.stats.n);
   }
-}
-
-Json StatsJson(const eval::ErrorStatistics& s) {
-  return Json{{"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median}, {"std", s.std},
-              {"min", s.min},   {"max", s.max},   {"sse", s.sse},       {"n", s.n}};
-}
-
-Json ResultJson(const EvalFlags& flags, eval::MetricKind metric, Eigen::Index ref_poses, const Evaluated& e) {
-  const eval::EvaluationResult& r = e.result;
-  const eval::Similarity& s = r.alignment.transform;
-  Json j;
-  j["command"] = std::string(eval::ToString(metric));
-  j["reference"] = {{"path", flags.reference}, {"poses", ref_poses}};
-  j["estimate"] = {{"path", e.path}, {"poses", e.poses}};
-  j["association"] = {{"pairs", r.association.size()}, {"max_diff", flags.t_max_diff}, {"offset", flags.t_offset}};
-  j["association"]["method"] = r.association.by_index ? "index" : flags.association;
-  Json rotation = Json::array();
-  for (int row = 0; row < 3; ++row) rotation.push_back({s.rotation(row, 0), s.rotation(row, 1), s.rotation(row, 2)});
-  j["alignment"] = {{"method", std::string(eval::ToString(r.alignment.method))},
-                    {"rotation", rotation},
-                    {"translation", {s.translation.x(), s.translation.y(), s.translation.z()}},
-                    {"scale", s.scale}};
-  if (r.alignment.method != eval::AlignmentMethod::kNone) j["alignment"]["pairs_used"] = r.alignment.pairs_used;
-  j["metric"] = {{"name", std::string(MetricName(metric))}, {"relation", r.relation}, {"unit", Unit(r)}};
-  if (metric == eval::MetricKind::kRpe) {
-    j["metric"]["delta"] = flags.delta;
-    j["metric"]["delta_unit"] = std::string(eval::ToString(ParseDeltaUnit(flags.delta_unit)));
-    j["metric"]["all_pairs"] = flags.all_pairs;
-  }
-  j["stats"] = StatsJson(r.stats);
-  if (r.ase) {
-    j["parts"] = Json::object();
-    if (r.ase->has_rotation) j["parts"]["rotation"] = StatsJson(r.rotation_stats);
-    j["parts"]["position"] = StatsJson(r.position_stats);
-    if (r.ase->has_velocity) j["parts"]["velocity"] = StatsJson(r.velocity_stats);
-    j["velocity_source"] = r.velocity_source;
-  }
-  if (r.drift) {
-    Json lengths = Json::array();
-    for (const auto& l : r.drift->lengths) {
-      lengths.push_back({{"length_m", l.length_m}, {"translation_percent", l.translation_percent},
-                         {"rotation_deg_per_m", l.rotation_deg_per_m}, {"segments", l.segments}});
-    }
-    j["drift"] = {{"translation_percent", r.drift->translation_percent},
-                  {"rotation_deg_per_m", r.drift->rotation_deg_per_m},
-                  {"segments", r.drift->segments},
-                  {"lengths", lengths}};
-  }
-  return j;
 }
 
 // Per-pair CSV: stamp (and the pair's second stamp for RPE), error, ASE parts; with several
@@ -197,7 +131,7 @@ std::string ErrorsCsv(const std::vector<Evaluated>& all, eval::MetricKind metric
   for (const Evaluated& e : all) {
     const eval::EvaluationResult& r = e.result;
     for (size_t k = 0; k < r.errors.size(); ++k) {
-      if (several) fmt::format_to(it, "{},", e.path);
+      if (several) fmt::format_to(it, "{},", e.estimate_path);
       fmt::format_to(it, "{}", traj::FormatSeconds(r.stamps_ns[k]));
       if (metric == eval::MetricKind::kRpe) fmt::format_to(it, ",{}", traj::FormatSeconds(r.stamps_end_ns[k]));
       fmt::format_to(it, ",{}", r.errors[k]);
@@ -229,14 +163,19 @@ void Run(CLI::App* command, eval::MetricKind metric, const EvalFlags& flags) {
   // Everything is evaluated before anything is written or printed: an error leaves no output file.
   std::vector<Evaluated> all;
   for (size_t k = 0; k < ests.size(); ++k) {
-    all.push_back({flags.estimates[k], ests[k].size(), eval::Evaluate(ref.View(), ests[k].View(), options)});
+    Evaluated e;
+    e.reference_path = flags.reference;
+    e.reference_poses = ref.size();
+    e.estimate_path = flags.estimates[k];
+    e.estimate_poses = ests[k].size();
+    e.max_diff_s = flags.t_max_diff;
+    e.offset_s = flags.t_offset;
+    e.options = options;
+    e.result = eval::Evaluate(ref.View(), ests[k].View(), options);
+    all.push_back(std::move(e));
   }
   std::string json_text, errors_text;
-  if (!flags.json_path.empty()) {
-    Json j = Json::array();
-    for (const Evaluated& e : all) j.push_back(ResultJson(flags, metric, ref.size(), e));
-    json_text = (all.size() == 1 ? j[0] : j).dump(2) + "\n";
-  }
+  if (!flags.json_path.empty()) json_text = eval::EvaluationJson(all);
   if (!flags.errors_path.empty()) errors_text = ErrorsCsv(all, metric);
 
   for (const Evaluated& e : all) PrintResult(flags, e, ref.size());

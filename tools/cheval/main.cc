@@ -19,9 +19,13 @@ int main(int argc, char** argv) {
   cheval::cli::RegisterConvert(app, &action);
   cheval::cli::RegisterSim(app, &action);
   cheval::cli::RegisterVelocity(app, &action);
+  cheval::cli::RegisterCompress(app, &action);
+  cheval::cli::RegisterSample(app, &action);
   cheval::cli::RegisterApe(app, &action);
   cheval::cli::RegisterRpe(app, &action);
   cheval::cli::RegisterAse(app, &action);
+  cheval::cli::RegisterSimQuadrotor(app, &action);
+  cheval::cli::RegisterEstimate(app, &action);
 
   auto fail = [](ExitCode code, const std::string& message) {
     std::fprintf(stderr, "%s\n", message.c_str());

@@ -27,20 +27,6 @@ struct VelocityFlags {
   InputFlags format;
 };
 
-// Stamps to evaluate at: a file of one stamp (seconds) per line, or any trajectory file.
-std::vector<int64_t> ReadQueryStamps(const std::string& path) {
-  try {
-    return traj::ReadStampsFile(path);
-  } catch (const InputError& as_stamps) {
-    try {
-      const traj::Trajectory trajectory = traj::ReadTrajectory(path);
-      return {trajectory.stamps_ns().begin(), trajectory.stamps_ns().end()};
-    } catch (const InputError&) {
-      throw as_stamps;  // report the simpler expectation
-    }
-  }
-}
-
 eval::VelocityOptions ToOptions(const VelocityFlags& flags, const traj::TrajectoryView& trajectory) {
   eval::VelocityOptions options;
   options.method = *eval::VelocityMethodFromString(flags.method);

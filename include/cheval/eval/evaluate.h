@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -91,10 +92,39 @@ struct EvaluationResult {
   std::optional<DriftResult> drift;
 };
 
+/// Checks the option combinations a caller can get wrong, before any work, and throws UsageError
+/// naming the CLI option and the rule: a negative association max_diff ("--t-max-diff"), a negative
+/// n_align, n_align without an alignment method, pose_only together with a body-frame estimate
+/// velocity.
+void ValidateEvaluationOptions(const EvaluationOptions& options);
+
 /// Evaluates `est` against `ref`. Throws UsageError for bad options and ComputeError when the
 /// evaluation is impossible (no pairs, degenerate alignment, missing orientation or velocity), with a
 /// message saying what to change.
 EvaluationResult Evaluate(const traj::TrajectoryView& ref, const traj::TrajectoryView& est,
                           const EvaluationOptions& options);
+
+/// One evaluated estimate with what its JSON names besides the result: the inputs and the options.
+struct EvaluationReport {
+  /// The reference and the estimate as the caller names them (file paths) and their pose counts.
+  std::string reference_path;
+  Eigen::Index reference_poses = 0;
+  std::string estimate_path;
+  Eigen::Index estimate_poses = 0;
+  /// The association's largest stamp difference and offset in seconds as the caller gave them
+  /// (EvaluationOptions holds them rounded to nanoseconds; the JSON repeats what was asked).
+  double max_diff_s = 0.01;
+  double offset_s = 0.0;
+  EvaluationOptions options;
+  EvaluationResult result;
+};
+
+/// The JSON of evaluations with the keys of METRICS.md §9 (docs/evaluation.md, "Output"): per report
+/// `command`, `reference`, `estimate`, `association`, `alignment`, `metric`, `stats`, and for RPE
+/// `metric.delta`, `metric.delta_unit`, `metric.all_pairs` (+ `drift`), for ASE `parts` and
+/// `velocity_source`. One object for one report, an array for several; 2-space indentation and a
+/// final newline; doubles in the shortest form that reads back to the same double. What `cheval
+/// ape|rpe|ase --json` writes and the Python module returns (as a dict).
+std::string EvaluationJson(std::span<const EvaluationReport> reports);
 
 }  // namespace cheval::eval

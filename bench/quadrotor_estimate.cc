@@ -1,0 +1,84 @@
+// Measured figures of docs/estimator.md (a plain program: it prints tables, it does not assert).
+//   quadrotor_estimate [VEHICLE_JSON] [--seeds N] [--scaling]
+// 1. Every scenario x seeds 1..N (default 3): per-motor mean rotor-speed error (rpm, %), pose and
+//    velocity RMSE, states, iterations, seconds (one core).
+// 2. --scaling: hover-like flights of 10 s .. 300 s at the default segment length: seconds per state.
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "cheval/estim/quadrotor_estimator.h"
+#include "cheval/estim/vehicle.h"
+#include "cheval/sim/quadrotor.h"
+
+using namespace cheval;
+
+namespace {
+
+struct Row {
+  estim::QuadrotorEstimate estimate;
+  sim::QuadrotorErrors errors;
+};
+
+Row Run(const estim::Vehicle& vehicle, sim::QuadrotorScenario scenario, uint64_t seed, double duration,
+        const estim::QuadrotorEstimateOptions& options) {
+  sim::QuadrotorSimOptions so;
+  so.scenario = scenario;
+  so.seed = seed;
+  so.duration_s = duration;
+  const sim::QuadrotorData data = sim::SimulateQuadrotor(vehicle, so);
+  std::vector<double> times;
+  for (const auto& t : data.truth) times.push_back(t.t);
+  Row row;
+  row.estimate = estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, options, times);
+  row.errors = sim::CompareWithTruth(row.estimate, data.truth);
+  return row;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string vehicle_path = CHEVAL_DEFAULT_VEHICLE;
+  int seeds = 3;
+  bool scaling = false;
+  double duration = 10.0;
+  estim::QuadrotorEstimateOptions options;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--seeds") && i + 1 < argc) seeds = std::stoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--scaling")) scaling = true;
+    else if (!std::strcmp(argv[i], "--duration") && i + 1 < argc) duration = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--degree") && i + 1 < argc) options.degree = std::stoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--segment") && i + 1 < argc) options.segment_s = std::stod(argv[++i]);
+    else vehicle_path = argv[i];
+  }
+  const estim::Vehicle vehicle = estim::ReadVehicle(vehicle_path);
+  if (!scaling) {
+    std::printf("%-11s %4s %6s %4s %7s | %-31s | %-27s | %8s %8s %8s\n", "scenario", "seed", "states", "it", "sec",
+                "rotor error rpm (motor 0..3)", "rotor error % (motor 0..3)", "pos m", "rot deg", "vel m/s");
+    double worst = 0;
+    for (sim::QuadrotorScenario scenario : sim::AllQuadrotorScenarios()) {
+      for (int seed = 1; seed <= seeds; ++seed) {
+        const Row r = Run(vehicle, scenario, seed, duration, options);
+        const auto& e = r.errors;
+        std::printf("%-11s %4d %6d %4d %7.3f | %7.2f %7.2f %7.2f %7.2f | %6.3f %6.3f %6.3f %6.3f | %8.4f %8.3f %8.4f%s\n",
+                    std::string(sim::ToString(scenario)).c_str(), seed, r.estimate.states, r.estimate.iterations,
+                    r.estimate.seconds, e.rotor_error_rpm[0], e.rotor_error_rpm[1], e.rotor_error_rpm[2],
+                    e.rotor_error_rpm[3], e.rotor_error_percent[0], e.rotor_error_percent[1], e.rotor_error_percent[2],
+                    e.rotor_error_percent[3], e.position_rmse_m, e.rotation_rmse_deg, e.velocity_rmse_mps,
+                    r.estimate.converged ? "" : "  (not converged)");
+        worst = std::max(worst, e.rotor_error_percent.maxCoeff());
+      }
+    }
+    std::printf("worst per-motor mean rotor-speed error: %.3f %%\n", worst);
+  } else {
+    std::printf("%9s %7s %9s %4s %9s %12s\n", "flight s", "states", "segments", "it", "seconds", "ms / state");
+    for (double d : {10.0, 30.0, 60.0, 120.0, 300.0}) {
+      const Row r = Run(vehicle, sim::QuadrotorScenario::kFigureEight, 1, d, options);
+      std::printf("%9.0f %7d %9d %4d %9.3f %12.3f   rotor error max %.3f %%\n", d, r.estimate.states,
+                  r.estimate.segments, r.estimate.iterations, r.estimate.seconds,
+                  1e3 * r.estimate.seconds / r.estimate.states, r.errors.rotor_error_percent.maxCoeff());
+    }
+  }
+  return 0;
+}

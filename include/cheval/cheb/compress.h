@@ -1,0 +1,67 @@
+#pragma once
+/// \file
+/// Compressing sampled positions into a TrajectoryModel (model.h), optionally to a guaranteed
+/// maximum error at the samples: `cheval compress` (docs/compress.md).
+
+#include <cstdint>
+#include <optional>
+#include <span>
+
+#include <Eigen/Core>
+
+#include "cheval/cheb/curve.h"
+#include "cheval/cheb/model.h"
+
+namespace cheval::cheb {
+
+/// Options of Compress.
+struct CompressOptions {
+  /// The automatic fit (FitCurve) and the limits of the tolerance fit (max_conditioning,
+  /// max_degree, min_window_samples, overlap); the defaults need no tuning.
+  CurveOptions curve;
+  /// The largest reconstruction error accepted (units of the samples: metres for positions): the
+  /// Euclidean norm of (model - sample) at every sample must not exceed it. It is a budget the
+  /// model spends: the result is the smallest model found within it, coarser than the automatic
+  /// fit when the tolerance is loose, finer when it is tight. nullopt: the automatic fit.
+  std::optional<double> tolerance;
+};
+
+/// A model and what it costs and achieves.
+struct Compression {
+  TrajectoryModel model;
+  /// The error of `model` as stored (through its values, CurveFromModel) at every input sample.
+  ReconstructionError error;
+  /// Numbers in the input's coordinate columns: dimension x samples (stamps not counted).
+  Eigen::Index input_numbers = 0;
+  /// ModelNumberCount(model) (values, window intervals, segment stamps, origin).
+  Eigen::Index model_numbers = 0;
+  /// input_numbers / model_numbers.
+  double ratio = 0;
+  /// Whether `model` is the automatic fit (always without a tolerance; with one, when the
+  /// automatic fit meets it with fewer numbers than the tolerance fit).
+  bool automatic = true;
+};
+
+/// Throws UsageError ("--tolerance must be a positive number of metres, got nan") unless the
+/// tolerance, when given, is positive and finite.
+void ValidateCompressOptions(const CompressOptions& options);
+
+/// Fits `values` (m x d; row i sampled at stamps_ns[i], any order) with FitCurve and stores the
+/// result as a model. With a tolerance M, each gap-free segment (as FitCurve splits them) is
+/// covered top-down instead: a window (first the whole segment) is fitted by least squares at the
+/// highest degree its samples allow — N²/m <= curve.max_conditioning (8), <= curve.max_degree,
+/// below the number of distinct stamps, well-conditioned normal equations — and if that fit is
+/// within M at every sample where the curve may use the window (its core and half its overlap),
+/// the window keeps the smallest degrees within M (per coordinate by bisection, then the
+/// coordinate that dominates the worst sample raised until the Euclidean norm is within M too);
+/// otherwise it is halved (windows overlap by curve.overlap of their core, as FitCurve's), down to
+/// curve.min_window_samples samples per core. Blending windows that are within M keeps the curve
+/// within M. The automatic model is kept instead when it meets M with fewer numbers.
+///
+/// Throws UsageError for a tolerance that is not a positive finite number; ComputeError when the
+/// data cannot be fitted (FitCurve: fewer than 2 samples, all stamps equal) or M cannot be met,
+/// giving the max and RMS error of the most accurate model found and the estimated noise.
+Compression Compress(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen::MatrixXd>& values,
+                     const CompressOptions& options = {});
+
+}  // namespace cheval::cheb

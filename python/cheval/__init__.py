@@ -1,0 +1,265 @@
+"""cheval: robot trajectory evaluation with Chebyshev methods, from Python.
+
+A thin face over the C++ library, as the ``cheval`` command is (docs/python.md)::
+
+    import cheval
+    gt = cheval.read("V102_groundtruth.csv")           # stamps (int64 ns), positions (n, 3), ...
+    r = cheval.ape(gt, "V102.txt", align="se3")        # the dict of `cheval ape ... --json`
+    v = cheval.velocity(gt, angular=True)              # Chebyshev velocities and body rates
+
+Trajectories and files go in wherever one is expected: a path (str or os.PathLike), a
+``cheval.Trajectory``, or a mapping with the Trajectory constructor's keys (``stamps``,
+``positions``, optional ``quaternions``, ``velocities``, ``angular_velocities``). Arrays come out
+as numpy arrays over the library's memory (no copy) where the layout allows; see docs/python.md for
+where a copy is made. Errors are the library's typed errors with the CLI's messages:
+``InputError`` and ``UsageError`` (both ``ValueError``), ``ComputeError`` (``RuntimeError``),
+``OutputError`` (``OSError``), all subclasses of ``cheval.Error``.
+"""
+
+import json as _json
+import os as _os
+from collections.abc import Mapping as _Mapping
+
+from . import _cheval
+from ._cheval import (  # noqa: F401  (re-exported)
+    ComputeError,
+    Compression,
+    Curve,
+    Error,
+    InputError,
+    Model,
+    OutputError,
+    Trajectory,
+    UsageError,
+    simulate,
+    write,
+    write_model,
+)
+
+__all__ = [
+    "Error", "InputError", "UsageError", "ComputeError", "OutputError",
+    "Trajectory", "Curve", "Model", "Compression",
+    "read", "write", "simulate", "velocity", "fit", "compress", "sample", "read_model", "write_model",
+    "associate", "align", "ape", "rpe", "ase",
+]
+
+for _cls in (Trajectory, Curve, Model, Compression):
+    _cls.__module__ = "cheval"  # shown as cheval.Trajectory, where users find them
+
+# evo's one-letter units of --delta-unit, as the CLI accepts them.
+_DELTA_UNIT_LETTERS = {"f": "frames", "m": "meters", "d": "degrees", "r": "radians"}
+
+
+def _columns_text(columns):
+    """A column map given as a list of role names, or as the CLI's comma-separated text."""
+    if columns is None:
+        return ""
+    return columns if isinstance(columns, str) else ",".join(columns)
+
+
+def read(path, format="auto", columns=None, kitti_times=None):
+    """Reads a trajectory file exactly as the CLI does (docs/formats.md) and returns a Trajectory.
+
+    format: 'auto' (decided from the content), 'tum', 'tumv', 'euroc', 'kitti', 'vins' or 'csv';
+    columns: a column map, e.g. 't_ns,px,py,pz,qw,qx,qy,qz' or a list of role names (implies csv;
+    '_' skips a column); kitti_times: a file with one stamp (seconds) per KITTI pose.
+    Raises InputError ('PATH:LINE:COLUMN: error: ...') for bad input, UsageError for bad arguments.
+    """
+    return _cheval.read(_os.fspath(path), format, _columns_text(columns),
+                        "" if kitti_times is None else _os.fspath(kitti_times))
+
+
+def read_model(path):
+    """Reads a model file written by ``cheval.write_model`` or ``cheval compress`` (a Model)."""
+    return _cheval.read_model(_os.fspath(path))
+
+
+def _trajectory(source, format="auto", columns=None, kitti_times=None):
+    """A Trajectory from a path, a Trajectory or a mapping of its constructor's arguments."""
+    if isinstance(source, Trajectory):
+        return source
+    if isinstance(source, (str, _os.PathLike)):
+        return read(source, format, columns, kitti_times)
+    if isinstance(source, _Mapping):
+        return Trajectory(**source)
+    raise TypeError(f"expected a path, a cheval.Trajectory or a mapping of arrays, got {type(source).__name__}")
+
+
+def _stamps(at):
+    """Query stamps: an int64 array (ns) or the stamps of a Trajectory."""
+    return at.stamps if isinstance(at, Trajectory) else at
+
+
+def _trajectory_to_dict(self):
+    """The trajectory's arrays by the constructor's names (views, no copy); None for absent channels."""
+    return {"stamps": self.stamps, "positions": self.positions, "quaternions": self.quaternions,
+            "velocities": self.velocities, "angular_velocities": self.angular_velocities}
+
+
+Trajectory.to_dict = _trajectory_to_dict
+
+
+def velocity(source, *, at=None, method="chebyshev", degree="auto", window=None, savgol_window=21,
+             angular=False, format="auto", columns=None, kitti_times=None):
+    """World-frame linear velocity from positions, as ``cheval velocity`` (docs/velocity.md).
+
+    source: a path, Trajectory or mapping (positions are used; orientations with angular=True).
+    at: int64 stamps (ns) or a Trajectory whose stamps to evaluate at (default: the source's own).
+    method: 'chebyshev' (windowed Chebyshev least squares, differentiated), 'central' or 'savgol'.
+    degree: 'auto' (= 'cv'), 'chop', 'threshold' or an int (a fixed degree: one global fit unless
+    a window is given); window: the Chebyshev window in seconds (default adaptive);
+    savgol_window: the Savitzky-Golay window in samples (odd, >= 5). angular: also body angular
+    velocity from the orientations.
+
+    Returns a dict: 'stamps' (n,) int64, 'velocities' (n, 3) m/s, 'positions' (n, 3) fitted
+    (chebyshev; else None), 'angular_velocities' (n, 3) rad/s or None, 'orientations' (n, 4) x y z w
+    fitted (chebyshev with angular) or None, 'curve' (the fitted Curve, chebyshev) or None,
+    'angular_residual_rms' (rad) or None. No array is copied on the way out.
+    """
+    trajectory = _trajectory(source, format, columns, kitti_times)
+    return _cheval.velocity(trajectory, at=None if at is None else _stamps(at), method=method,
+                            degree=degree, window=window, savgol_window=savgol_window, angular=angular)
+
+
+def fit(source, values=None, *, degree="auto", window=None, noise=None, format="auto", columns=None,
+        kitti_times=None):
+    """A Curve fitted to samples: fit(stamps, values) with int64 stamps (ns) and values (n, d),
+    d <= 4, or fit(trajectory_or_path) for its positions. Evaluate it with curve.evaluate(stamps,
+    order). degree: 'auto' (= 'cv'), 'chop', 'threshold' or an int; window (s); noise (sigma of the
+    samples; default estimated). See cheval.Curve.
+    """
+    if values is not None:
+        return _cheval.fit(source, values, degree=degree, window=window, noise=noise)
+    return _cheval.fit(_trajectory(source, format, columns, kitti_times), degree=degree, window=window,
+                       noise=noise)
+
+
+def compress(source, values=None, *, tolerance=None, format="auto", columns=None, kitti_times=None):
+    """The pseudo-spectral model of samples, as ``cheval compress`` (docs/compress.md):
+    compress(stamps, values) or compress(trajectory_or_path) for its positions. tolerance: the
+    largest error accepted at every sample (units of the samples, metres for positions), or
+    None for the automatic fit. Returns a Compression (.model, .ratio, .max_error, ...).
+    """
+    if values is not None:
+        return _cheval.compress(source, values, tolerance=tolerance)
+    return _cheval.compress(_trajectory(source, format, columns, kitti_times), tolerance=tolerance)
+
+
+def sample(model, *, rate=None, at=None):
+    """Values of a model (a Model or a model file's path), as ``cheval sample``: every 1/rate s
+    from its first stamp to its last (gaps skipped), or at int64 stamps / a Trajectory's stamps
+    ``at``. Returns {'stamps': (n,) int64, 'values': (n, d)}.
+    """
+    if not isinstance(model, Model):
+        model = read_model(model)
+    return _cheval.sample(model, rate=rate, at=None if at is None else _stamps(at))
+
+
+def _sides(ref, est, options):
+    """The reference and estimate Trajectories, with the CLI's input options: format / columns /
+    kitti_times for both, ref_* and est_* for one side."""
+    def side(source, prefix):
+        def get(name):
+            value = options.get(prefix + name)
+            return options.get(name) if value is None else value
+        return _trajectory(source, get("format") or "auto", get("columns"), get("kitti_times"))
+    return side(ref, "ref_"), side(est, "est_")
+
+
+_INPUT_OPTIONS = {f"{prefix}{name}" for prefix in ("", "ref_", "est_")
+                  for name in ("format", "columns", "kitti_times")}
+
+
+def _check_input_options(function, options):
+    unknown = set(options) - _INPUT_OPTIONS
+    if unknown:
+        raise TypeError(f"{function}() got unexpected keyword argument(s): {', '.join(sorted(unknown))}")
+
+
+def associate(ref, est, *, t_max_diff=0.01, t_offset=0.0, **inputs):
+    """evo's time association (docs/evaluation.md): for each pose of the shorter trajectory the
+    nearest stamp of the other within t_max_diff seconds (inclusive), est + t_offset = ref.
+    Returns {'ref': (k,) int64 indices, 'est': (k,) int64 indices, 'by_index': bool} (KITTI files
+    without stamps pair pose i with pose i). Input options as in ape().
+    """
+    _check_input_options("associate", inputs)
+    r, e = _sides(ref, est, inputs)
+    return _cheval.associate(r, e, t_max_diff=t_max_diff, t_offset=t_offset)
+
+
+def align(ref, est, *, method="se3", n_align=0, t_max_diff=0.01, t_offset=0.0, **inputs):
+    """The alignment of the estimate onto the reference from the associated pairs, as ``--align``:
+    method 'none', 'origin', 'se3', 'sim3', 'scale', 'posyaw' or 'full'; n_align: solve from the
+    first N pairs (0: all). Returns {'method', 'rotation' (3, 3), 'translation' (3,), 'scale',
+    'pairs_used'}; an estimate state maps to R' = R R_i, p' = R (c p_i) + t, v' = c R v_i.
+    """
+    _check_input_options("align", inputs)
+    r, e = _sides(ref, est, inputs)
+    return _cheval.align(r, e, method=method, n_align=n_align, t_max_diff=t_max_diff, t_offset=t_offset)
+
+
+def _evaluate(metric, ref, est, errors, inputs, options):
+    _check_input_options(metric, inputs)
+    r, e = _sides(ref, est, inputs)
+    if "delta_unit" in options:
+        options["delta_unit"] = _DELTA_UNIT_LETTERS.get(options["delta_unit"], options["delta_unit"])
+    text, per_pair = _cheval.evaluate(r, e, metric, **options)
+    result = _json.loads(text)
+    if errors:
+        result["errors"] = per_pair
+    return result
+
+
+_COMMON_DOC = """
+    ref, est: paths, Trajectories or mappings of arrays. Input options as the CLI's: format,
+    columns, kitti_times for both files, ref_format, est_columns, ... for one side.
+    align: 'none', 'origin', 'se3', 'sim3', 'scale', 'posyaw' or 'full'; n_align: solve it from the
+    first N pairs; t_max_diff, t_offset (s): the association (est + t_offset = ref);
+    association: 'nearest' (evo) or 'continuous' (the reference's Chebyshev curve at the estimate
+    stamps).
+
+    Returns the dict the CLI's --json writes (same keys, same numbers; 'path' is the path given,
+    or '<array>'). errors=True adds 'errors': per-pair numpy arrays 'stamps' (int64 ns), 'error'
+    (+ 'stamps_end' for RPE, the parts for ASE), as the CLI's --errors CSV.
+    Raises InputError, UsageError or ComputeError with the CLI's messages.
+"""
+
+
+def ape(ref, est, *, align="none", n_align=0, t_max_diff=0.01, t_offset=0.0, association="nearest",
+        relation="trans_part", errors=False, **inputs):
+    return _evaluate("ape", ref, est, errors, inputs, dict(
+        align=align, n_align=n_align, t_max_diff=t_max_diff, t_offset=t_offset, association=association,
+        relation=relation))
+
+
+def rpe(ref, est, *, align="none", n_align=0, t_max_diff=0.01, t_offset=0.0, association="nearest",
+        relation="trans_part", delta=1.0, delta_unit="frames", all_pairs=False, kitti_drift=False,
+        errors=False, **inputs):
+    return _evaluate("rpe", ref, est, errors, inputs, dict(
+        align=align, n_align=n_align, t_max_diff=t_max_diff, t_offset=t_offset, association=association,
+        relation=relation, delta=delta, delta_unit=delta_unit, all_pairs=all_pairs, kitti_drift=kitti_drift))
+
+
+def ase(ref, est, *, align="none", n_align=0, t_max_diff=0.01, t_offset=0.0, association="nearest",
+        gt_velocity="auto", velocity_frame="world", pose_only=False, errors=False, **inputs):
+    return _evaluate("ase", ref, est, errors, inputs, dict(
+        align=align, n_align=n_align, t_max_diff=t_max_diff, t_offset=t_offset, association=association,
+        gt_velocity=gt_velocity, velocity_frame=velocity_frame, pose_only=pose_only))
+
+
+ape.__doc__ = """Absolute pose error, as ``cheval ape`` (evo_ape's definitions and numbers).
+
+    relation: 'trans_part', 'rot_part', 'full', 'angle_deg', 'angle_rad' or 'point_distance'.
+""" + _COMMON_DOC
+rpe.__doc__ = """Relative pose error, as ``cheval rpe`` (evo_rpe's definitions and numbers).
+
+    relation as ape(); delta and delta_unit ('frames', 'meters', 'degrees', 'radians' or evo's
+    f, m, d, r): the pair distance; all_pairs: overlapping pairs from every pose; kitti_drift: also
+    the KITTI drift (% and deg/m over 100..800 m).
+""" + _COMMON_DOC
+ase.__doc__ = """Absolute State Error on SE_2(3), as ``cheval ase`` (rotation, position, velocity; C-ASE).
+
+    gt_velocity: 'auto' (its columns, else Chebyshev), 'given', 'chebyshev' or 'central';
+    velocity_frame: the estimate's velocity columns are 'world' or 'body'; pose_only: rotation +
+    position only, for estimates without velocity.
+""" + _COMMON_DOC

@@ -1,0 +1,192 @@
+// Evaluation in Python: velocity from positions, association, alignment, and APE / RPE / ASE with the
+// CLI's JSON (eval::EvaluationJson, the same text `--json` writes).
+#include <optional>
+
+#include <fmt/format.h>
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include "bindings.h"
+#include "cheval/common/error.h"
+#include "cheval/eval/evaluate.h"
+
+namespace cheval::python {
+namespace {
+
+// The value of an enum option parsed by the library's FromString, or UsageError listing the choices.
+template <typename Enum>
+Enum Choice(std::optional<Enum> parsed, const char* option, const std::string& value, const char* choices) {
+  if (!parsed) throw UsageError(fmt::format("{}: expected one of {}, got '{}'", option, choices, value));
+  return *parsed;
+}
+
+bool OneOf(const std::string& value, const char* option, const char* first, const char* second) {
+  if (value != first && value != second) {
+    throw UsageError(fmt::format("{}: expected '{}' or '{}', got '{}'", option, first, second, value));
+  }
+  return value == second;
+}
+
+eval::AssociationOptions AssociationOptionsOf(double t_max_diff, double t_offset) {
+  eval::AssociationOptions options;
+  options.max_diff_ns = eval::SecondsToNanoseconds(t_max_diff, "--t-max-diff");
+  options.offset_ns = eval::SecondsToNanoseconds(t_offset, "--t-offset");
+  return options;
+}
+
+py::dict Velocity(const py::object& self, const py::object& at, const std::string& method, const py::object& degree,
+                  std::optional<double> window, int savgol_window, bool angular) {
+  const PyTrajectory& t = self.cast<const PyTrajectory&>();
+  const traj::TrajectoryView view = t.trajectory.View();
+  if (!view.has_stamps()) throw ComputeError("velocity needs stamps; give the KITTI times with kitti_times=");
+  eval::VelocityOptions options;
+  options.method = Choice(eval::VelocityMethodFromString(method), "method", method, "chebyshev, central, savgol");
+  if (window && options.method == eval::VelocityMethod::kSavitzkyGolay) {
+    throw UsageError("window= is the Chebyshev window in seconds; give the Savitzky-Golay window in samples with "
+                     "savgol_window=");
+  }
+  options.curve = CurveOptionsOf(degree, window, std::nullopt);
+  options.savgol_window = savgol_window;
+  options.angular = angular;
+  std::optional<py::array_t<int64_t>> query;
+  if (!at.is_none()) query = StampsArray(at);
+  eval::VelocityEstimate estimate;
+  {
+    py::gil_scoped_release release;
+    estimate = eval::EstimateVelocity(view, options,
+                                      query ? std::optional<std::span<const int64_t>>(SpanOf(*query)) : std::nullopt);
+  }
+  py::dict out;
+  out["stamps"] = query ? py::object(*query)
+                        : py::object(ViewOf(view.stamps_ns().data(), {view.size()},
+                                            {static_cast<py::ssize_t>(sizeof(int64_t))}, self));
+  out["velocities"] = AdoptColumns(std::move(estimate.velocities));
+  out["positions"] = estimate.positions.cols() > 0 ? py::object(AdoptColumns(std::move(estimate.positions))) : py::none();
+  out["angular_velocities"] =
+      angular ? py::object(AdoptColumns(std::move(estimate.angular_velocities))) : py::object(py::none());
+  if (!estimate.orientations.empty()) {
+    static_assert(sizeof(Eigen::Quaterniond) == 4 * sizeof(double), "quaternions are 4 packed doubles (x y z w)");
+    const auto n = static_cast<py::ssize_t>(estimate.orientations.size());
+    constexpr auto kDouble = static_cast<py::ssize_t>(sizeof(double));
+    out["orientations"] = AdoptArray<double>(
+        std::move(estimate.orientations), [](const std::vector<Eigen::Quaterniond>& q) { return q.front().coeffs().data(); },
+        {n, 4}, {4 * kDouble, kDouble});
+  } else {
+    out["orientations"] = py::none();
+  }
+  out["curve"] = estimate.curve ? py::cast(std::move(*estimate.curve)) : py::none();
+  out["angular_residual_rms"] =
+      estimate.rotation_curve ? py::cast(estimate.rotation_curve->residual_rms_rad()) : py::object(py::none());
+  return out;
+}
+
+py::dict Associate(const PyTrajectory& ref, const PyTrajectory& est, double t_max_diff, double t_offset) {
+  const eval::AssociationOptions options = AssociationOptionsOf(t_max_diff, t_offset);
+  eval::Association association;
+  {
+    py::gil_scoped_release release;
+    association = eval::Associate(ref.trajectory.View(), est.trajectory.View(), options);
+  }
+  py::dict out;
+  out["ref"] = AdoptVector(std::move(association.ref));
+  out["est"] = AdoptVector(std::move(association.est));
+  out["by_index"] = association.by_index;
+  return out;
+}
+
+py::dict Align(const PyTrajectory& ref, const PyTrajectory& est, const std::string& method, Eigen::Index n_align,
+               double t_max_diff, double t_offset) {
+  eval::EvaluationOptions options;
+  options.association = AssociationOptionsOf(t_max_diff, t_offset);
+  options.alignment.method = Choice(eval::AlignmentMethodFromString(method), "method", method,
+                                    "none, origin, se3, sim3, scale, posyaw, full");
+  options.alignment.n_align = n_align;
+  eval::ValidateEvaluationOptions(options);
+  eval::AlignmentResult result;
+  {
+    py::gil_scoped_release release;
+    const traj::TrajectoryView r = ref.trajectory.View(), e = est.trajectory.View();
+    const eval::Association association = eval::Associate(r, e, options.association);
+    result = eval::ComputeAlignment(eval::PairedStates(r, e, association), options.alignment);
+  }
+  py::dict out;
+  out["method"] = std::string(eval::ToString(result.method));
+  out["rotation"] = Eigen::Matrix3d(result.transform.rotation);
+  out["translation"] = Eigen::Vector3d(result.transform.translation);
+  out["scale"] = result.transform.scale;
+  out["pairs_used"] = result.pairs_used;
+  return out;
+}
+
+// One evaluation: the JSON text of `cheval ape|rpe|ase --json` and the per-pair arrays (no copies).
+py::tuple Evaluate(const PyTrajectory& ref, const PyTrajectory& est, const std::string& metric, const std::string& align,
+                   Eigen::Index n_align, double t_max_diff, double t_offset, const std::string& association,
+                   const std::string& relation, double delta, const std::string& delta_unit, bool all_pairs,
+                   bool kitti_drift, const std::string& gt_velocity, const std::string& velocity_frame,
+                   bool pose_only) {
+  eval::EvaluationReport report;
+  eval::EvaluationOptions& options = report.options;
+  options.metric = metric == "ape" ? eval::MetricKind::kApe : metric == "rpe" ? eval::MetricKind::kRpe : eval::MetricKind::kAse;
+  options.association = AssociationOptionsOf(t_max_diff, t_offset);
+  options.continuous_reference = OneOf(association, "association", "nearest", "continuous");
+  options.alignment.method = Choice(eval::AlignmentMethodFromString(align), "align", align,
+                                    "none, origin, se3, sim3, scale, posyaw, full");
+  options.alignment.n_align = n_align;
+  options.relation = Choice(eval::PoseRelationFromString(relation), "relation", relation,
+                            "trans_part, rot_part, full, angle_deg, angle_rad, point_distance");
+  options.rpe.delta = delta;
+  options.rpe.delta_unit =
+      Choice(eval::DeltaUnitFromString(delta_unit), "delta_unit", delta_unit, "frames, meters, degrees, radians");
+  options.rpe.all_pairs = all_pairs;
+  options.kitti_drift = kitti_drift;
+  options.reference_velocity = Choice(eval::ReferenceVelocitySourceFromString(gt_velocity), "gt_velocity",
+                                      gt_velocity, "auto, given, chebyshev, central");
+  options.estimate_velocity_body_frame = OneOf(velocity_frame, "velocity_frame", "world", "body");
+  options.pose_only = pose_only;
+  eval::ValidateEvaluationOptions(options);
+  report.reference_path = ref.path;
+  report.reference_poses = ref.trajectory.size();
+  report.estimate_path = est.path;
+  report.estimate_poses = est.trajectory.size();
+  report.max_diff_s = t_max_diff;
+  report.offset_s = t_offset;
+  std::string json;
+  {
+    py::gil_scoped_release release;
+    report.result = eval::Evaluate(ref.trajectory.View(), est.trajectory.View(), options);
+    json = eval::EvaluationJson(std::span<const eval::EvaluationReport>(&report, 1));
+  }
+  eval::EvaluationResult& r = report.result;
+  py::dict details;
+  details["stamps"] = AdoptVector(std::move(r.stamps_ns));
+  if (options.metric == eval::MetricKind::kRpe) details["stamps_end"] = AdoptVector(std::move(r.stamps_end_ns));
+  details["error"] = AdoptVector(std::move(r.errors));
+  if (r.ase) {
+    if (r.ase->has_rotation) details["rotation"] = AdoptVector(std::move(r.ase->rotation));
+    details["position"] = AdoptVector(std::move(r.ase->position));
+    if (r.ase->has_velocity) details["velocity"] = AdoptVector(std::move(r.ase->velocity));
+  }
+  return py::make_tuple(json, details);
+}
+
+}  // namespace
+
+void BindEvaluation(py::module_& m) {
+  m.def("velocity", &Velocity, py::arg("trajectory"), py::kw_only(), py::arg("at") = py::none(),
+        py::arg("method") = "chebyshev", py::arg("degree") = "auto", py::arg("window") = py::none(),
+        py::arg("savgol_window") = 21, py::arg("angular") = false,
+        "The compiled velocity; use cheval.velocity (docs/python.md).");
+  m.def("associate", &Associate, py::arg("ref"), py::arg("est"), py::kw_only(), py::arg("t_max_diff") = 0.01,
+        py::arg("t_offset") = 0.0, "The compiled association; use cheval.associate.");
+  m.def("align", &Align, py::arg("ref"), py::arg("est"), py::kw_only(), py::arg("method") = "se3",
+        py::arg("n_align") = 0, py::arg("t_max_diff") = 0.01, py::arg("t_offset") = 0.0,
+        "The compiled alignment; use cheval.align.");
+  m.def("evaluate", &Evaluate, py::arg("ref"), py::arg("est"), py::arg("metric"), py::kw_only(),
+        py::arg("align") = "none", py::arg("n_align") = 0, py::arg("t_max_diff") = 0.01, py::arg("t_offset") = 0.0,
+        py::arg("association") = "nearest", py::arg("relation") = "trans_part", py::arg("delta") = 1.0,
+        py::arg("delta_unit") = "frames", py::arg("all_pairs") = false, py::arg("kitti_drift") = false,
+        py::arg("gt_velocity") = "auto", py::arg("velocity_frame") = "world", py::arg("pose_only") = false,
+        "The compiled evaluation; use cheval.ape, cheval.rpe, cheval.ase.");
+}
+
+}  // namespace cheval::python

@@ -1,0 +1,115 @@
+// The extension module `cheval._cheval`: the library's typed errors as Python exceptions, the numpy
+// hand-over helpers, and the registration of every binding. python/cheval/__init__.py is the public
+// face over it (docs/python.md).
+#include <exception>
+
+#include "bindings.h"
+#include "cheval/common/error.h"
+
+namespace cheval::python {
+namespace {
+
+// The exception classes, created once when the module is imported (they live as long as Python).
+PyObject* g_error = nullptr;
+PyObject* g_input_error = nullptr;
+PyObject* g_usage_error = nullptr;
+PyObject* g_compute_error = nullptr;
+PyObject* g_output_error = nullptr;
+
+PyObject* NewException(py::module_& m, const char* name, const char* doc, py::tuple bases) {
+  const std::string qualified = std::string("cheval.") + name;
+  PyObject* type = PyErr_NewExceptionWithDoc(qualified.c_str(), doc, bases.ptr(), nullptr);
+  if (type == nullptr) throw py::error_already_set();
+  m.add_object(name, py::handle(type));  // the module keeps a reference; so does `type` (never released)
+  return type;
+}
+
+// Raises `type` with the library's message (what()) as its only argument, the message a CLI user sees.
+void Raise(PyObject* type, const std::exception& e) { PyErr_SetString(type, e.what()); }
+
+}  // namespace
+
+void BindErrors(py::module_& m) {
+  const py::handle exception(PyExc_Exception), value_error(PyExc_ValueError), runtime_error(PyExc_RuntimeError),
+      os_error(PyExc_OSError);
+  g_error = NewException(m, "Error", "Base of every error cheval raises; str(e) is the complete message.",
+                         py::make_tuple(exception));
+  const py::handle error(g_error);
+  // The typed errors: name, description, the standard exception each also is.
+  const struct {
+    PyObject** type;
+    const char* name;
+    const char* doc;
+    py::handle standard;
+  } kErrors[] = {
+      {&g_input_error, "InputError",
+       "Bad input data (a file or arrays): the message is 'PATH:LINE:COLUMN: error: WHAT' (the CLI's exit code 2). "
+       "Attributes: path, line, column (1-based; 0 = the file as a whole) and detail (WHAT alone).",
+       value_error},
+      {&g_usage_error, "UsageError",
+       "A bad option value or combination, found before any work (the CLI's exit code 1).", value_error},
+      {&g_compute_error, "ComputeError",
+       "Well-formed input on which the computation is impossible, e.g. no associated pair or too few samples "
+       "(the CLI's exit code 3). The message says what to change.",
+       runtime_error},
+      {&g_output_error, "OutputError", "An output file could not be written; nothing partial is left (exit code 4).",
+       os_error},
+  };
+  for (const auto& e : kErrors) *e.type = NewException(m, e.name, e.doc, py::make_tuple(error, e.standard));
+
+  py::register_exception_translator([](std::exception_ptr thrown) {
+    try {
+      if (thrown) std::rethrow_exception(thrown);
+    } catch (const InputError& e) {
+      py::object exc = py::handle(g_input_error)(e.what());
+      exc.attr("path") = e.path();
+      exc.attr("line") = e.line();
+      exc.attr("column") = e.column();
+      exc.attr("detail") = e.detail();
+      PyErr_SetObject(g_input_error, exc.ptr());
+    } catch (const UsageError& e) {
+      Raise(g_usage_error, e);
+    } catch (const ComputeError& e) {
+      Raise(g_compute_error, e);
+    } catch (const OutputError& e) {
+      Raise(g_output_error, e);
+    }
+  });
+}
+
+py::array AdoptColumns(Eigen::Matrix3Xd&& columns) {
+  const auto n = static_cast<py::ssize_t>(columns.cols());
+  constexpr auto kDouble = static_cast<py::ssize_t>(sizeof(double));
+  return AdoptArray<double>(std::move(columns), [](const Eigen::Matrix3Xd& m) { return m.data(); }, {n, 3},
+                            {3 * kDouble, kDouble});
+}
+
+py::array AdoptMatrix(Eigen::MatrixXd&& matrix) {
+  const auto rows = static_cast<py::ssize_t>(matrix.rows()), cols = static_cast<py::ssize_t>(matrix.cols());
+  constexpr auto kDouble = static_cast<py::ssize_t>(sizeof(double));
+  return AdoptArray<double>(std::move(matrix), [](const Eigen::MatrixXd& m) { return m.data(); }, {rows, cols},
+                            {kDouble, rows * kDouble});
+}
+
+py::array_t<int64_t> StampsArray(const py::handle& stamps) {
+  const py::array array = py::array::ensure(stamps);
+  if (!array) throw py::type_error("stamps: expected an array of integer nanoseconds");
+  const char kind = array.dtype().kind();
+  if (kind != 'i' && kind != 'u') {
+    throw py::type_error("stamps must be integer nanoseconds (int64), got dtype " +
+                         py::str(array.dtype()).cast<std::string>() +
+                         "; from seconds: numpy.round(seconds * 1e9).astype(numpy.int64)");
+  }
+  if (array.ndim() != 1) throw py::value_error("stamps: expected a 1-D array, got " + std::to_string(array.ndim()) + "-D");
+  return py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(array);
+}
+
+}  // namespace cheval::python
+
+PYBIND11_MODULE(_cheval, m) {
+  m.doc() = "The compiled core of the Python module cheval; import cheval instead (docs/python.md).";
+  cheval::python::BindErrors(m);
+  cheval::python::BindTrajectory(m);
+  cheval::python::BindChebyshev(m);
+  cheval::python::BindEvaluation(m);
+}

@@ -1,0 +1,154 @@
+#include "cheval/estim/quadrotor_estimator.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "cheval/common/error.h"
+#include "cheval/estim/problem.h"
+#include "cheval/lie/so3.h"
+
+namespace cheval::estim {
+namespace {
+
+using Problem = PseudoSpectralProblem<QuadrotorModel>;
+
+// Pixel residuals of the landmarks of one frame, whitened by the pixel σ.
+struct FrameProjection {
+  Eigen::Matrix3d camera_from_body;
+  double fx, fy, cx, cy, inv_sigma;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector2d> pixels;
+
+  template <typename T>
+  bool operator()(const T* x, const Eigen::Matrix<T, 3, 3>& R, T* r) const {
+    const Eigen::Matrix<T, 3, 1> p(x[0], x[1], x[2]);
+    const Eigen::Matrix<T, 3, 3> C = camera_from_body.cast<T>() * R.transpose();
+    for (size_t i = 0; i < points.size(); ++i) {
+      const Eigen::Matrix<T, 3, 1> c = C * (points[i].cast<T>() - p);
+      if (c.z() < T(1e-3)) return false;  // behind the camera: Ceres rejects the step
+      r[2 * i] = (T(fx) * c.x() / c.z() + T(cx) - T(pixels[i].x())) * T(inv_sigma);
+      r[2 * i + 1] = (T(fy) * c.y() / c.z() + T(cy) - T(pixels[i].y())) * T(inv_sigma);
+    }
+    return true;
+  }
+};
+
+// The front end's pose at t, interpolated (linear / slerp) between its samples.
+struct InitialTrajectory {
+  const std::vector<PoseSample>& poses;
+  PoseSample At(double t) const {
+    auto it = std::lower_bound(poses.begin(), poses.end(), t, [](const PoseSample& s, double v) { return s.t < v; });
+    if (it == poses.begin()) return poses.front();
+    if (it == poses.end()) return poses.back();
+    const PoseSample& b = *it;
+    const PoseSample& a = *(it - 1);
+    const double f = b.t > a.t ? (t - a.t) / (b.t - a.t) : 0.0;
+    return {t, a.p + f * (b.p - a.p), a.q.slerp(f, b.q)};
+  }
+};
+
+}  // namespace
+
+QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Eigen::Vector3d>& landmarks,
+                                    const std::vector<PixelObservation>& pixels,
+                                    const std::vector<PoseSample>& initial, const QuadrotorEstimateOptions& options,
+                                    const std::vector<double>& query_times) {
+  const auto start = std::chrono::steady_clock::now();
+  if (options.degree < 2 || options.degree > 64) throw UsageError(fmt::format("--degree must be in [2, 64], got {}", options.degree));
+  if (!(options.segment_s > 0) || !std::isfinite(options.segment_s)) {
+    throw UsageError(fmt::format("--segment must be a positive number of seconds, got {}", options.segment_s));
+  }
+  if (pixels.empty()) throw ComputeError("no camera measurements");
+  double t0 = pixels.front().t, t1 = pixels.front().t;
+  for (const PixelObservation& m : pixels) {
+    t0 = std::min(t0, m.t);
+    t1 = std::max(t1, m.t);
+    if (m.landmark < 0 || m.landmark >= static_cast<int>(landmarks.size())) {
+      throw ComputeError(fmt::format("measurement at {:.6f} s refers to landmark {}, but the map has {}", m.t, m.landmark,
+                                     landmarks.size()));
+    }
+  }
+  if (!(t1 > t0)) throw ComputeError("the camera measurements span no time (need frames at 2 or more times)");
+  if (initial.empty() || initial.front().t > t0 + 1e-6 || initial.back().t < t1 - 1e-6) {
+    throw ComputeError(fmt::format("the initial poses ({:.6f} .. {:.6f} s) do not cover the measurement interval "
+                                   "[{:.6f}, {:.6f}] s",
+                                   initial.empty() ? 0.0 : initial.front().t, initial.empty() ? 0.0 : initial.back().t,
+                                   t0, t1));
+  }
+  const int segments = std::max(1, static_cast<int>(std::lround((t1 - t0) / options.segment_s)));
+  std::vector<double> breakpoints(segments + 1);
+  for (int s = 0; s <= segments; ++s) breakpoints[s] = t0 + (t1 - t0) * s / segments;
+  breakpoints.back() = t1;
+  Problem problem(QuadrotorModel{vehicle.quadrotor}, breakpoints, options.degree);
+
+  // Initial values: the front end's poses; velocity and body rate from its differences over ±0.1 s;
+  // rotor speeds at hover.
+  const InitialTrajectory front_end{initial};
+  const double hover = vehicle.quadrotor.HoverRotorSpeed();
+  for (int g = 0; g < problem.num_nodes(); ++g) {
+    const double t = problem.NodeTime(g);
+    const PoseSample pose = front_end.At(t);
+    const double h = 0.1;
+    const PoseSample before = front_end.At(std::max(t - h, initial.front().t)),
+                     after = front_end.At(std::min(t + h, initial.back().t));
+    const double dt = std::max(after.t - before.t, 1e-9);
+    const Eigen::Vector3d v = (after.p - before.p) / dt;
+    const Eigen::Vector3d w = lie::SO3d(after.q).Minus(lie::SO3d(before.q)) / dt;
+    Eigen::VectorXd x(9);
+    x << pose.p, v, w;
+    problem.SetNode(g, x, pose.q.toRotationMatrix(), Eigen::Vector4d::Constant(hover));
+  }
+  problem.SetChartReferences();
+
+  Eigen::Matrix<double, 12, 1> sigma;
+  sigma << Eigen::Vector3d::Constant(options.sigma_position_rate), Eigen::Vector3d::Constant(options.sigma_acceleration),
+      Eigen::Vector3d::Constant(options.sigma_angular_acceleration), Eigen::Vector3d::Constant(options.sigma_rotation_rate);
+  problem.AddCollocation(sigma);
+  if (options.sigma_rotor_rate > 0) problem.AddControlRatePrior(options.sigma_rotor_rate);
+
+  const PinholeCamera& cam = vehicle.camera;
+  const double pixel_sigma = std::max(cam.pixel_noise_px, 0.1);  // a noise-free file still gets a finite weight
+  ceres::HuberLoss huber(options.huber_pixels);
+  for (size_t i = 0; i < pixels.size();) {
+    FrameProjection frame{PinholeCamera::BodyFromCamera().transpose(), cam.fx, cam.fy, cam.cx, cam.cy, 1.0 / pixel_sigma,
+                          {}, {}};
+    size_t j = i;
+    for (; j < pixels.size() && pixels[j].t == pixels[i].t; ++j) {
+      frame.points.push_back(landmarks[pixels[j].landmark]);
+      frame.pixels.push_back(pixels[j].uv);
+    }
+    const int rows = static_cast<int>(2 * (j - i));
+    problem.AddMeasurement(pixels[i].t, std::move(frame), rows, 2, {0}, &huber);
+    i = j;
+  }
+
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  solver.max_num_iterations = options.max_iterations;
+  solver.num_threads = options.threads;
+  solver.logging_type = ceres::SILENT;
+  const ceres::Solver::Summary summary = problem.Solve(solver);
+
+  QuadrotorEstimate out;
+  out.states = problem.num_nodes();
+  out.segments = problem.num_segments();
+  out.degree = problem.degree();
+  out.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  out.converged = summary.termination_type == ceres::CONVERGENCE;
+  out.solver_report = summary.BriefReport();
+  out.start_time = t0;
+  out.end_time = t1;
+  for (double t : query_times) {
+    if (t < t0 || t > t1) continue;
+    const StateSample s = problem.Interpolate(t);
+    out.samples.push_back({t, s.vector.segment<3>(0), s.vector.segment<3>(3), s.vector.segment<3>(6), s.rotation,
+                           s.control.head<4>()});
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace cheval::estim

@@ -1,0 +1,543 @@
+#include "cheval/sim/quadrotor.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <random>
+#include <sstream>
+
+#include "cheval/common/error.h"
+#include "cheval/lie/so3.h"
+#include "cheval/traj/io.h"
+
+namespace cheval::sim {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kWarmUpS = 3.0;  // flown before t = 0, not recorded
+
+// One axis of a reference: c + rate·t + Σ A sin(ω t + φ).
+struct Wave {
+  double amplitude, frequency, phase;
+};
+struct Axis {
+  double center = 0, rate = 0;
+  std::vector<Wave> waves;
+  // Value and derivatives 0..2.
+  std::array<double, 3> At(double t) const {
+    std::array<double, 3> out{center + rate * t, rate, 0.0};
+    for (const Wave& w : waves) {
+      const double s = std::sin(w.frequency * t + w.phase), c = std::cos(w.frequency * t + w.phase);
+      out[0] += w.amplitude * s;
+      out[1] += w.amplitude * w.frequency * c;
+      out[2] -= w.amplitude * w.frequency * w.frequency * s;
+    }
+    return out;
+  }
+};
+struct Reference {
+  Axis x, y, z, yaw;
+};
+
+Reference MakeReference(QuadrotorScenario scenario) {
+  Reference r;
+  r.z.center = 1.5;
+  switch (scenario) {
+    case QuadrotorScenario::kHover:
+      break;
+    case QuadrotorScenario::kLine:  // -2 m .. +2 m along x and back, every 8 s
+      r.x.waves = {{2.0, 2 * kPi / 8, -kPi / 2}};
+      break;
+    case QuadrotorScenario::kCircle:  // radius 2 m in 6 s, facing along the path
+      r.x.waves = {{2.0, 2 * kPi / 6, kPi / 2}};
+      r.y.waves = {{2.0, 2 * kPi / 6, 0.0}};
+      r.yaw.center = kPi / 2;
+      r.yaw.rate = 2 * kPi / 6;
+      break;
+    case QuadrotorScenario::kFigureEight:
+      r.x.waves = {{2.5, 2 * kPi / 8, 0.0}};
+      r.y.waves = {{1.5, 4 * kPi / 8, 0.0}};
+      break;
+    case QuadrotorScenario::kLissajous:
+      r.x.waves = {{3.0, 2 * kPi / 7, 0.0}};
+      r.y.waves = {{2.0, 2 * kPi / 5, 0.5}};
+      r.z.waves = {{0.5, 2 * kPi / 4, 0.0}};
+      r.yaw.waves = {{0.5, 0.7, 0.0}};
+      break;
+    case QuadrotorScenario::kAggressive:  // up to ~12 m/s² and 1.3 rad/s of yaw
+      r.x.waves = {{3.0, 1.6, 0.0}};
+      r.y.waves = {{2.0, 2.4, 0.0}};
+      r.z.center = 2.0;
+      r.z.waves = {{0.6, 2.0, 0.0}};
+      r.yaw.waves = {{1.0, 1.3, 0.0}};
+      break;
+  }
+  return r;
+}
+
+// Gaussian numbers from std::mt19937_64 through our own Box–Muller transform (the standard's
+// distributions differ between libraries; this does not).
+class Gaussian {
+ public:
+  Gaussian(uint64_t seed, uint64_t stream) : engine_(seed * 0x9E3779B97F4A7C15ULL + stream * 0xD1B54A32D192ED03ULL + 1) {}
+  double Uniform() { return (static_cast<double>(engine_() >> 11) + 0.5) * 0x1.0p-53; }
+  double Normal() {
+    if (spare_) {
+      spare_ = false;
+      return cached_;
+    }
+    const double r = std::sqrt(-2.0 * std::log(Uniform())), a = 2 * kPi * Uniform();
+    cached_ = r * std::sin(a);
+    spare_ = true;
+    return r * std::cos(a);
+  }
+  Eigen::Vector3d Normal3() {
+    const double a = Normal(), b = Normal(), c = Normal();
+    return {a, b, c};
+  }
+  uint64_t Bits() { return engine_(); }
+
+ private:
+  std::mt19937_64 engine_;
+  bool spare_ = false;
+  double cached_ = 0;
+};
+
+// Simulation state: p, q (x y z w), v, ω, Ω.
+struct State {
+  Eigen::Vector3d p, v, w;
+  Eigen::Quaterniond q;
+  Eigen::Vector4d rotor;
+};
+struct Derivative {
+  Eigen::Vector3d p, v, w;
+  Eigen::Vector4d q, rotor;
+};
+
+class Simulator {
+ public:
+  Simulator(const estim::QuadrotorParameters& params, Reference reference)
+      : model_{params}, reference_(std::move(reference)) {
+    const double a = params.arm_m, k = params.moment_coefficient / params.thrust_coefficient;
+    Eigen::Matrix4d mix;  // [T, τx, τy, τz] = mix · f
+    mix << 1, 1, 1, 1,  //
+        a, a, -a, -a,   //
+        -a, a, a, -a,   //
+        -k, k, -k, k;
+    unmix_ = mix.inverse();
+    const double wn = 15.0, zeta = 0.8;  // attitude loop; the motors (τ = 0.02 s) are ~3x faster
+    k_R_ = params.inertia_kgm2 * wn * wn;
+    k_w_ = params.inertia_kgm2 * 2 * zeta * wn;
+  }
+
+  // The force the controller asks for (world), and the desired rotation.
+  void Desired(const State& s, double t, Eigen::Vector3d* force, Eigen::Matrix3d* R_d) const {
+    const estim::QuadrotorParameters& m = model_.parameters;
+    const auto x = reference_.x.At(t), y = reference_.y.At(t), z = reference_.z.At(t), yaw = reference_.yaw.At(t);
+    const Eigen::Vector3d p_r(x[0], y[0], z[0]), v_r(x[1], y[1], z[1]), a_r(x[2], y[2], z[2]);
+    const double kp = 4.0, kd = 3.6;  // position loop: ω_n = 2 rad/s, ζ = 0.9
+    *force = m.mass_kg * (a_r + Eigen::Vector3d(0, 0, m.gravity_mps2) - kp * (s.p - p_r) - kd * (s.v - v_r)) +
+             m.drag_coefficient * s.v.norm() * s.v;
+    const Eigen::Vector3d b3 = force->normalized();
+    const Eigen::Vector3d b1c(std::cos(yaw[0]), std::sin(yaw[0]), 0.0);
+    const Eigen::Vector3d b2 = b3.cross(b1c).normalized();
+    R_d->col(0) = b2.cross(b3);
+    R_d->col(1) = b2;
+    R_d->col(2) = b3;
+  }
+
+  // Rotor speed command (rad/s) of a state; counts saturation.
+  Eigen::Vector4d Command(const State& s, double t, bool* saturated) const {
+    const estim::QuadrotorParameters& m = model_.parameters;
+    Eigen::Vector3d force;
+    Eigen::Matrix3d R_d;
+    Desired(s, t, &force, &R_d);
+    const Eigen::Matrix3d R = s.q.toRotationMatrix();
+    const double thrust = force.dot(R.col(2));
+    const Eigen::Matrix3d E = R_d.transpose() * R - R.transpose() * R_d;
+    const Eigen::Vector3d e_R = 0.5 * Eigen::Vector3d(E(2, 1), E(0, 2), E(1, 0));
+    const Eigen::Vector3d Jw = m.inertia_kgm2.cwiseProduct(s.w);
+    const Eigen::Vector3d tau = -k_R_.cwiseProduct(e_R) - k_w_.cwiseProduct(s.w) + s.w.cross(Jw);
+    Eigen::Vector4d wrench(thrust, tau.x(), tau.y(), tau.z());
+    const Eigen::Vector4d f = unmix_ * wrench;
+    Eigen::Vector4d command;
+    for (int i = 0; i < 4; ++i) {
+      double speed = std::sqrt(std::max(f[i], 0.0) / m.thrust_coefficient);
+      if (f[i] < 0 || speed > m.max_rotor_speed_radps) *saturated = true;
+      command[i] = std::min(speed, m.max_rotor_speed_radps);
+    }
+    return command;
+  }
+
+  Derivative Rate(const State& s, double t, bool* saturated) const {
+    Derivative d;
+    double x[9], x_dot[9], omega[3];
+    for (int i = 0; i < 3; ++i) {
+      x[i] = s.p[i];
+      x[3 + i] = s.v[i];
+      x[6 + i] = s.w[i];
+    }
+    model_.Dynamics(x, Eigen::Matrix3d(s.q.toRotationMatrix()), s.rotor.data(), x_dot, omega);
+    d.p = Eigen::Vector3d(x_dot[0], x_dot[1], x_dot[2]);
+    d.v = Eigen::Vector3d(x_dot[3], x_dot[4], x_dot[5]);
+    d.w = Eigen::Vector3d(x_dot[6], x_dot[7], x_dot[8]);
+    const Eigen::Quaterniond qdot = s.q * Eigen::Quaterniond(0, 0.5 * omega[0], 0.5 * omega[1], 0.5 * omega[2]);
+    d.q = qdot.coeffs();
+    d.rotor = (Command(s, t, saturated) - s.rotor) / model_.parameters.motor_time_constant_s;
+    return d;
+  }
+
+  static State Add(const State& s, const Derivative& d, double h) {
+    State out = s;
+    out.p += h * d.p;
+    out.v += h * d.v;
+    out.w += h * d.w;
+    out.q.coeffs() += h * d.q;
+    out.rotor += h * d.rotor;
+    return out;
+  }
+
+  // One classical RK4 step of length h; the quaternion is re-normalised after the step.
+  State Step(const State& s, double t, double h, bool* saturated) const {
+    const Derivative k1 = Rate(s, t, saturated);
+    const Derivative k2 = Rate(Add(s, k1, h / 2), t + h / 2, saturated);
+    const Derivative k3 = Rate(Add(s, k2, h / 2), t + h / 2, saturated);
+    const Derivative k4 = Rate(Add(s, k3, h), t + h, saturated);
+    Derivative sum;
+    sum.p = k1.p + 2 * k2.p + 2 * k3.p + k4.p;
+    sum.v = k1.v + 2 * k2.v + 2 * k3.v + k4.v;
+    sum.w = k1.w + 2 * k2.w + 2 * k3.w + k4.w;
+    sum.q = k1.q + 2 * k2.q + 2 * k3.q + k4.q;
+    sum.rotor = k1.rotor + 2 * k2.rotor + 2 * k3.rotor + k4.rotor;
+    State out = Add(s, sum, h / 6);
+    out.q.normalize();
+    return out;
+  }
+
+  // The reference state at t = 0 with the attitude and rotor speeds that fly it.
+  State Initial(double t0) const {
+    State s;
+    const auto x = reference_.x.At(t0), y = reference_.y.At(t0), z = reference_.z.At(t0);
+    s.p = Eigen::Vector3d(x[0], y[0], z[0]);
+    s.v = Eigen::Vector3d(x[1], y[1], z[1]);
+    s.w.setZero();
+    Eigen::Vector3d force;
+    Eigen::Matrix3d R_d;
+    s.q = Eigen::Quaterniond::Identity();
+    s.rotor.setZero();
+    Desired(s, t0, &force, &R_d);
+    s.q = Eigen::Quaterniond(R_d);
+    bool ignored = false;
+    s.rotor = Command(s, t0, &ignored);
+    return s;
+  }
+
+ private:
+  estim::QuadrotorModel model_;
+  Reference reference_;
+  Eigen::Matrix4d unmix_;
+  Eigen::Vector3d k_R_, k_w_;
+};
+
+QuadrotorTruth ToTruth(const State& s, double t) { return {t, s.p, s.q, s.v, s.w, s.rotor}; }
+
+// Landmarks on the faces of the room [-10, 10]² x [0, 6], uniform in area.
+std::vector<Eigen::Vector3d> MakeLandmarks(int count, Gaussian& random) {
+  std::vector<Eigen::Vector3d> points;
+  const double wall = 20.0 * 6.0, floor = 20.0 * 20.0, total = 4 * wall + 2 * floor;
+  for (int i = 0; i < count; ++i) {
+    double pick = random.Uniform() * total;
+    const double a = random.Uniform() * 20.0 - 10.0, b = random.Uniform();
+    if (pick < 4 * wall) {
+      const int face = std::min(3, static_cast<int>(pick / wall));
+      const double h = b * 6.0;
+      const Eigen::Vector3d options[4] = {{10, a, h}, {-10, a, h}, {a, 10, h}, {a, -10, h}};
+      points.push_back(options[face]);
+    } else {
+      pick -= 4 * wall;
+      points.emplace_back(a, b * 20.0 - 10.0, pick < floor ? 0.0 : 6.0);
+    }
+  }
+  return points;
+}
+
+void Require(bool ok, const std::string& message) {
+  if (!ok) throw UsageError(message);
+}
+
+}  // namespace
+
+std::string_view ToString(QuadrotorScenario scenario) {
+  switch (scenario) {
+    case QuadrotorScenario::kHover: return "hover";
+    case QuadrotorScenario::kLine: return "line";
+    case QuadrotorScenario::kCircle: return "circle";
+    case QuadrotorScenario::kFigureEight: return "figure8";
+    case QuadrotorScenario::kLissajous: return "lissajous";
+    case QuadrotorScenario::kAggressive: return "aggressive";
+  }
+  return "?";
+}
+
+std::optional<QuadrotorScenario> QuadrotorScenarioFromString(std::string_view name) {
+  for (QuadrotorScenario s : AllQuadrotorScenarios()) {
+    if (ToString(s) == name) return s;
+  }
+  return std::nullopt;
+}
+
+std::vector<QuadrotorScenario> AllQuadrotorScenarios() {
+  return {QuadrotorScenario::kHover,       QuadrotorScenario::kLine,      QuadrotorScenario::kCircle,
+          QuadrotorScenario::kFigureEight, QuadrotorScenario::kLissajous, QuadrotorScenario::kAggressive};
+}
+
+std::optional<Eigen::Vector2d> Project(const estim::PinholeCamera& camera, const Eigen::Vector3d& p,
+                                       const Eigen::Matrix3d& R, const Eigen::Vector3d& x) {
+  const Eigen::Vector3d c = estim::PinholeCamera::BodyFromCamera().transpose() * (R.transpose() * (x - p));
+  if (c.z() < 0.1) return std::nullopt;
+  const Eigen::Vector2d uv(camera.fx * c.x() / c.z() + camera.cx, camera.fy * c.y() / c.z() + camera.cy);
+  if (uv.x() < 0 || uv.y() < 0 || uv.x() > camera.width || uv.y() > camera.height) return std::nullopt;
+  return uv;
+}
+
+QuadrotorData SimulateQuadrotor(const estim::Vehicle& vehicle, const QuadrotorSimOptions& options) {
+  estim::ValidateVehicle(vehicle, "<vehicle>");
+  Require(std::isfinite(options.duration_s) && options.duration_s > 0 && options.duration_s <= 3600,
+          fmt::format("--duration must be in (0, 3600] s, got {}", options.duration_s));
+  Require(options.integration_rate_hz >= 100 && options.integration_rate_hz <= 1e5,
+          "the integration rate must be in [100, 1e5] Hz");
+  Require(options.truth_rate_hz > 0 && options.truth_rate_hz <= options.integration_rate_hz,
+          "the truth rate must be in (0, integration rate]");
+  Require(options.landmarks > 0 && options.max_features_per_frame > 0, "landmarks and features must be > 0");
+  QuadrotorData data;
+  data.vehicle = vehicle;
+  Gaussian landmark_random(options.seed, 1), pixel_random(options.seed, 2), vo_random(options.seed, 3),
+      pick_random(options.seed, 4);
+  data.landmarks = MakeLandmarks(options.landmarks, landmark_random);
+
+  const Simulator sim(vehicle.quadrotor, MakeReference(options.scenario));
+  const estim::PinholeCamera& camera = vehicle.camera;
+  const double h = 1.0 / options.integration_rate_hz;
+  const int64_t steps = std::llround(options.duration_s * options.integration_rate_hz);
+  const int64_t truth_every = std::max<int64_t>(1, std::llround(options.integration_rate_hz / options.truth_rate_hz));
+  const double frame_dt = 1.0 / camera.rate_hz;
+  int64_t next_frame = 0;
+  Eigen::Vector3d drift_p = Eigen::Vector3d::Zero(), drift_r = Eigen::Vector3d::Zero();
+  // Warm-up: the vehicle starts on the reference at t = -kWarmUpS and flies until t = 0 before
+  // anything is recorded, so the controller's start-up transient is not part of the data.
+  State s = sim.Initial(-kWarmUpS);
+  for (int64_t i = std::llround(-kWarmUpS * options.integration_rate_hz); i < 0; ++i) {
+    bool saturated = false;
+    s = sim.Step(s, static_cast<double>(i) * h, h, &saturated);
+  }
+  auto frame = [&](const State& at, double t) {
+    const Eigen::Matrix3d R = at.q.toRotationMatrix();
+    std::vector<int> visible;
+    std::vector<Eigen::Vector2d> uvs;
+    for (int i = 0; i < static_cast<int>(data.landmarks.size()); ++i) {
+      if (auto uv = Project(camera, at.p, R, data.landmarks[i])) {
+        visible.push_back(i);
+        uvs.push_back(*uv);
+      }
+    }
+    // A front end tracks a random subset of at most max_features_per_frame (partial Fisher–Yates).
+    const int keep = std::min<int>(options.max_features_per_frame, static_cast<int>(visible.size()));
+    for (int i = 0; i < keep; ++i) {
+      const int j = i + static_cast<int>(pick_random.Bits() % static_cast<uint64_t>(visible.size() - i));
+      std::swap(visible[i], visible[j]);
+      std::swap(uvs[i], uvs[j]);
+    }
+    std::vector<PixelMeasurement> seen;
+    for (int i = 0; i < keep; ++i) {
+      const Eigen::Vector2d noise(pixel_random.Normal(), pixel_random.Normal());
+      seen.push_back({t, visible[i], uvs[i] + camera.pixel_noise_px * noise});
+    }
+    std::sort(seen.begin(), seen.end(), [](const auto& a, const auto& b) { return a.landmark < b.landmark; });
+    data.pixels.insert(data.pixels.end(), seen.begin(), seen.end());
+    if (next_frame > 0) {
+      drift_p += options.vo_position_drift_m_per_sqrt_s * std::sqrt(frame_dt) * vo_random.Normal3();
+      drift_r += options.vo_rotation_drift_rad_per_sqrt_s * std::sqrt(frame_dt) * vo_random.Normal3();
+    }
+    const Eigen::Vector3d np = options.vo_position_noise_m * vo_random.Normal3();
+    const Eigen::Vector3d nr = options.vo_rotation_noise_rad * vo_random.Normal3();
+    const Eigen::Quaterniond q_vo = lie::SO3d(at.q).Plus(drift_r + nr).quaternion();
+    data.initial.push_back({t, at.p + drift_p + np, q_vo});
+  };
+  for (int64_t i = 0; i <= steps; ++i) {
+    const double t = static_cast<double>(i) * h;
+    if (i % truth_every == 0) data.truth.push_back(ToTruth(s, t));
+    // Frames in [t, t + h): a partial RK4 step from this grid point.
+    while (static_cast<double>(next_frame) * frame_dt < t + h - 1e-12 &&
+           static_cast<double>(next_frame) * frame_dt <= options.duration_s + 1e-12) {
+      const double tf = static_cast<double>(next_frame) * frame_dt;
+      bool ignored = false;
+      frame(tf - t > 1e-12 ? sim.Step(s, t, tf - t, &ignored) : s, tf);
+      ++next_frame;
+    }
+    if (i == steps) break;
+    bool saturated = false;
+    s = sim.Step(s, t, h, &saturated);
+    if (saturated) ++data.saturated_steps;
+  }
+  if (data.saturated_steps > steps / 100) {
+    throw ComputeError(fmt::format("the vehicle cannot fly scenario '{}': rotor commands saturated in {} of {} steps",
+                                   ToString(options.scenario), data.saturated_steps, steps));
+  }
+  return data;
+}
+
+QuadrotorErrors CompareWithTruth(const estim::QuadrotorEstimate& estimate, const std::vector<QuadrotorTruth>& truth) {
+  QuadrotorErrors e;
+  Eigen::Vector4d abs_sum = Eigen::Vector4d::Zero(), true_sum = Eigen::Vector4d::Zero();
+  double p2 = 0, r2 = 0, v2 = 0;
+  size_t k = 0;
+  for (const estim::QuadrotorStateEstimate& s : estimate.samples) {
+    while (k < truth.size() && truth[k].t < s.t - 1e-9) ++k;
+    if (k == truth.size()) break;
+    if (std::abs(truth[k].t - s.t) > 1e-9) continue;
+    const QuadrotorTruth& g = truth[k];
+    abs_sum += (s.rotor - g.rotor).cwiseAbs();
+    true_sum += g.rotor;
+    p2 += (s.p - g.p).squaredNorm();
+    v2 += (s.v - g.v).squaredNorm();
+    const double angle = lie::SO3d(Eigen::Matrix3d(s.R.transpose() * g.q.toRotationMatrix())).Log().norm();
+    r2 += angle * angle;
+    ++e.samples;
+  }
+  if (e.samples == 0) throw ComputeError("the estimate and the ground truth share no time");
+  const double n = e.samples;
+  e.rotor_error_rpm = abs_sum / n * 60.0 / (2 * kPi);
+  e.rotor_error_percent = 100.0 * abs_sum.cwiseQuotient(true_sum);
+  e.position_rmse_m = std::sqrt(p2 / n);
+  e.rotation_rmse_deg = std::sqrt(r2 / n) * 180.0 / kPi;
+  e.velocity_rmse_mps = std::sqrt(v2 / n);
+  return e;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Data folder.
+
+namespace {
+
+std::string Num(double x) { return fmt::format("{:.17g}", x); }
+
+void WriteText(const std::filesystem::path& path, const std::string& text) {
+  traj::WriteFileAtomically(path.string(), text);
+}
+
+// Rows of a CSV file with a header line; every row must have `columns` numbers.
+std::vector<std::vector<double>> ReadCsv(const std::filesystem::path& path, size_t columns) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string(), 0, 0, "cannot open (required file of a quadrotor data folder)");
+  std::vector<std::vector<double>> rows;
+  std::string line;
+  int64_t number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.empty() || line[0] == '#' || (number == 1 && !std::isdigit(static_cast<unsigned char>(line[0])) &&
+                                           line[0] != '-' && line[0] != '.')) {
+      continue;
+    }
+    std::vector<double> row;
+    const char* p = line.data();
+    const char* end = line.data() + line.size();
+    while (p < end) {
+      double value = 0;
+      const auto [next, ec] = std::from_chars(p, end, value);
+      if (ec != std::errc() || !std::isfinite(value)) {
+        throw InputError(path.string(), number, p - line.data() + 1, "expected a finite number");
+      }
+      row.push_back(value);
+      p = next;
+      if (p < end && *p == ',') ++p;
+      else if (p < end) throw InputError(path.string(), number, p - line.data() + 1, "expected ','");
+    }
+    if (row.size() != columns) {
+      throw InputError(path.string(), number, 1, fmt::format("expected {} fields, got {}", columns, row.size()));
+    }
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+}  // namespace
+
+void WriteQuadrotorData(const QuadrotorData& data, const std::string& folder) {
+  const std::filesystem::path dir(folder);
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw OutputError(fmt::format("{}: error: cannot create folder: {}", folder, ec.message()));
+  WriteText(dir / "vehicle.json", estim::VehicleToJson(data.vehicle));
+  std::string text = "id,x,y,z\n";
+  for (size_t i = 0; i < data.landmarks.size(); ++i) {
+    const Eigen::Vector3d& x = data.landmarks[i];
+    text += fmt::format("{},{},{},{}\n", i, Num(x.x()), Num(x.y()), Num(x.z()));
+  }
+  WriteText(dir / "landmarks.csv", text);
+  text = "t,landmark,u,v\n";
+  for (const PixelMeasurement& m : data.pixels) {
+    text += fmt::format("{},{},{},{}\n", Num(m.t), m.landmark, Num(m.uv.x()), Num(m.uv.y()));
+  }
+  WriteText(dir / "measurements.csv", text);
+  text = "t,px,py,pz,qw,qx,qy,qz\n";
+  for (const PoseSample& s : data.initial) {
+    text += fmt::format("{},{},{},{},{},{},{},{}\n", Num(s.t), Num(s.p.x()), Num(s.p.y()), Num(s.p.z()), Num(s.q.w()),
+                        Num(s.q.x()), Num(s.q.y()), Num(s.q.z()));
+  }
+  WriteText(dir / "initial.csv", text);
+  text = "t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,rotor0,rotor1,rotor2,rotor3\n";
+  for (const QuadrotorTruth& s : data.truth) {
+    text += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", Num(s.t), Num(s.p.x()), Num(s.p.y()),
+                        Num(s.p.z()), Num(s.q.w()), Num(s.q.x()), Num(s.q.y()), Num(s.q.z()), Num(s.v.x()),
+                        Num(s.v.y()), Num(s.v.z()), Num(s.w.x()), Num(s.w.y()), Num(s.w.z()), Num(s.rotor[0]),
+                        Num(s.rotor[1]), Num(s.rotor[2]), Num(s.rotor[3]));
+  }
+  if (!data.truth.empty()) WriteText(dir / "truth.csv", text);
+}
+
+QuadrotorData ReadQuadrotorData(const std::string& folder) {
+  const std::filesystem::path dir(folder);
+  if (!std::filesystem::is_directory(dir)) throw InputError(folder, 0, 0, "not a folder (expected a quadrotor data folder)");
+  QuadrotorData data;
+  data.vehicle = estim::ReadVehicle((dir / "vehicle.json").string());
+  for (const auto& row : ReadCsv(dir / "landmarks.csv", 4)) {
+    if (row[0] != static_cast<double>(data.landmarks.size())) {
+      throw InputError((dir / "landmarks.csv").string(), static_cast<int64_t>(data.landmarks.size()) + 2, 1,
+                       "landmark ids must be 0, 1, 2, ... in order");
+    }
+    data.landmarks.emplace_back(row[1], row[2], row[3]);
+  }
+  int64_t line = 1;
+  for (const auto& row : ReadCsv(dir / "measurements.csv", 4)) {
+    ++line;
+    const int id = static_cast<int>(row[1]);
+    if (row[1] != id || id < 0 || id >= static_cast<int>(data.landmarks.size())) {
+      throw InputError((dir / "measurements.csv").string(), line, 1, fmt::format("unknown landmark id {}", row[1]));
+    }
+    if (!data.pixels.empty() && row[0] < data.pixels.back().t) {
+      throw InputError((dir / "measurements.csv").string(), line, 1, "measurement times must not decrease");
+    }
+    data.pixels.push_back({row[0], id, Eigen::Vector2d(row[2], row[3])});
+  }
+  for (const auto& row : ReadCsv(dir / "initial.csv", 8)) {
+    data.initial.push_back({row[0], Eigen::Vector3d(row[1], row[2], row[3]),
+                            Eigen::Quaterniond(row[4], row[5], row[6], row[7]).normalized()});
+  }
+  if (data.initial.size() < 2) throw InputError((dir / "initial.csv").string(), 0, 0, "needs at least 2 poses");
+  if (std::filesystem::exists(dir / "truth.csv")) {
+    for (const auto& r : ReadCsv(dir / "truth.csv", 18)) {
+      data.truth.push_back({r[0], Eigen::Vector3d(r[1], r[2], r[3]), Eigen::Quaterniond(r[4], r[5], r[6], r[7]).normalized(),
+                            Eigen::Vector3d(r[8], r[9], r[10]), Eigen::Vector3d(r[11], r[12], r[13]),
+                            Eigen::Vector4d(r[14], r[15], r[16], r[17])});
+    }
+  }
+  return data;
+}
+
+}  // namespace cheval::sim

@@ -1,0 +1,187 @@
+// The quadrotor: model (torques of the motor layout, hover), vehicle files (good and bad), the
+// simulator (physics consistency with the model, camera, determinism) and the estimator end to end.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "cheval/common/error.h"
+#include "cheval/estim/models.h"
+#include "cheval/estim/quadrotor_estimator.h"
+#include "cheval/estim/vehicle.h"
+#include "cheval/sim/quadrotor.h"
+
+namespace cheval {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kVehicle = std::string(CHEVAL_SOURCE_DIR) + "/data/vehicles/flightgoggles.json";
+
+TEST(QuadrotorModel, ShippedVehicleHoversAtTheDocumentedSpeed) {
+  const estim::Vehicle v = estim::ReadVehicle(kVehicle);
+  // ESTIMATOR.md: sqrt(m g / 4 k_F) ≈ 1133 rad/s for the FlightGoggles vehicle.
+  EXPECT_NEAR(v.quadrotor.HoverRotorSpeed(), std::sqrt(1.0 * 9.81 / (4 * 1.91e-6)), 1e-9);
+  EXPECT_NEAR(v.quadrotor.HoverRotorSpeed(), 1133.1, 0.1);
+  const estim::QuadrotorModel model{v.quadrotor};
+  double x[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, x_dot[9], omega[3];
+  const double h = v.quadrotor.HoverRotorSpeed();
+  const double u[4] = {h, h, h, h};
+  model.Dynamics(x, Eigen::Matrix3d::Identity().eval(), u, x_dot, omega);
+  for (int i = 0; i < 9; ++i) EXPECT_NEAR(x_dot[i], 0.0, 1e-12) << i;
+}
+
+// Motor layout of ESTIMATOR.md: speeding up the two left motors (0, 1; y = +a) rolls right-side
+// down (τ_x > 0); the front ones (0, 3; x = +a) pitch nose up (τ_y < 0); the +1-spin motors (1, 3)
+// yaw positive.
+TEST(QuadrotorModel, TorquesFollowTheMotorLayout) {
+  estim::QuadrotorParameters p = estim::ReadVehicle(kVehicle).quadrotor;
+  const estim::QuadrotorModel model{p};
+  const double h = 1000, d = 10;
+  const double left[4] = {h + d, h + d, h, h}, front[4] = {h + d, h, h, h + d}, spin[4] = {h, h + d, h, h + d};
+  const double df = p.thrust_coefficient * ((h + d) * (h + d) - h * h);
+  EXPECT_NEAR(model.Torque(left).x(), 2 * p.arm_m * df, 1e-12);
+  EXPECT_NEAR(model.Torque(front).y(), -2 * p.arm_m * df, 1e-12);
+  EXPECT_NEAR(model.Torque(spin).z(), 2 * p.moment_coefficient * ((h + d) * (h + d) - h * h), 1e-12);
+  EXPECT_NEAR(model.Torque(left).z(), 0.0, 1e-12);
+}
+
+class VehicleFileTest : public ::testing::Test {
+ protected:
+  std::string Write(const std::string& text) {
+    path_ = fs::temp_directory_path() / ("cheval_vehicle_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+                                         ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".json");
+    std::ofstream(path_) << text;
+    return path_.string();
+  }
+  void TearDown() override { fs::remove(path_); }
+  // The shipped file with one "key": value replaced.
+  std::string Shipped(const std::string& from, const std::string& to) {
+    std::ifstream in(kVehicle);
+    std::string text((std::istreambuf_iterator<char>(in)), {});
+    const size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return text.replace(at, from.size(), to);
+  }
+  void ExpectError(const std::string& text, const std::string& message) {
+    try {
+      estim::ReadVehicle(Write(text));
+      ADD_FAILURE() << "no error for " << message;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
+  fs::path path_;
+};
+
+TEST_F(VehicleFileTest, NonPhysicalOrMissingValuesAreErrors) {
+  ExpectError(Shipped("\"mass_kg\": 1.0", "\"mass_kg\": -1.0"), "\"mass_kg\" must be a finite number > 0, got -1");
+  ExpectError(Shipped("[0.0049, 0.0049, 0.0069]", "[0.0049, 0, 0.0069]"), "singular or negative inertia");
+  ExpectError(Shipped("[0.0049, 0.0049, 0.0069]", "[0.001, 0.001, 0.01]"), "triangle inequality");
+  ExpectError(Shipped("\"mass_kg\": 1.0,", ""), "missing key \"mass_kg\"");
+  ExpectError(Shipped("\"fx\": 400", "\"fx\": \"400\""), "\"camera.fx\" must be a number");
+  ExpectError(Shipped("\"max_rotor_speed_radps\": 2200", "\"max_rotor_speed_radps\": 1000"), "cannot fly");
+  ExpectError("{ not json", "not valid JSON");
+  EXPECT_THROW(estim::ReadVehicle("/nonexistent/vehicle.json"), InputError);
+}
+
+// The simulator integrates the estimator's own model: the truth samples satisfy v = dp/dt to the
+// accuracy of a central difference at 100 Hz (O(h²·p''') ≈ 1e-3 m/s for these flights).
+TEST(QuadrotorSim, TruthIsConsistentAndDeterministic) {
+  const estim::Vehicle v = estim::ReadVehicle(kVehicle);
+  sim::QuadrotorSimOptions options;
+  options.scenario = sim::QuadrotorScenario::kFigureEight;
+  options.duration_s = 3.0;
+  const sim::QuadrotorData a = sim::SimulateQuadrotor(v, options), b = sim::SimulateQuadrotor(v, options);
+  ASSERT_EQ(a.truth.size(), 301u);
+  EXPECT_EQ(a.initial.size(), 91u);  // 30 Hz over 3 s, both ends
+  ASSERT_EQ(a.pixels.size(), b.pixels.size());
+  for (size_t i = 0; i < a.pixels.size(); ++i) EXPECT_EQ(a.pixels[i].uv, b.pixels[i].uv);
+  for (size_t i = 1; i + 1 < a.truth.size(); ++i) {
+    const Eigen::Vector3d fd = (a.truth[i + 1].p - a.truth[i - 1].p) / 0.02;
+    EXPECT_LT((fd - a.truth[i].v).norm(), 2e-3) << i;
+  }
+  // Every frame sees at most max_features_per_frame landmarks, inside the image.
+  for (const auto& m : a.pixels) {
+    EXPECT_GE(m.uv.x(), -5.0);
+    EXPECT_LE(m.uv.x(), v.camera.width + 5.0);
+  }
+  options.seed = 2;
+  EXPECT_NE(sim::SimulateQuadrotor(v, options).pixels.front().uv, a.pixels.front().uv);
+}
+
+TEST(QuadrotorSim, DataFolderRoundTripAndMissingFiles) {
+  const estim::Vehicle v = estim::ReadVehicle(kVehicle);
+  sim::QuadrotorSimOptions options;
+  options.duration_s = 1.0;
+  const sim::QuadrotorData data = sim::SimulateQuadrotor(v, options);
+  const fs::path dir = fs::temp_directory_path() / "cheval_quadrotor_roundtrip";
+  fs::remove_all(dir);
+  sim::WriteQuadrotorData(data, dir.string());
+  const sim::QuadrotorData back = sim::ReadQuadrotorData(dir.string());
+  ASSERT_EQ(back.pixels.size(), data.pixels.size());
+  EXPECT_EQ(back.pixels.back().uv, data.pixels.back().uv);  // %.17g round-trips doubles exactly
+  EXPECT_EQ(back.truth.back().rotor, data.truth.back().rotor);
+  EXPECT_EQ(back.landmarks.size(), data.landmarks.size());
+  fs::remove(dir / "measurements.csv");
+  try {
+    sim::ReadQuadrotorData(dir.string());
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("measurements.csv:0:0: error: cannot open"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+// End to end on a short hover and a short figure-eight with the defaults: the rotor speeds come back
+// to well within 1 % (the 10 s runs of docs/estimator.md measure 0.3-0.7 %; 3 s flights have
+// relatively more interval ends, so the bound here is 1 %), poses to a centimetre.
+TEST(QuadrotorEstimator, RecoversRotorSpeedsFromTheCamera) {
+  const estim::Vehicle v = estim::ReadVehicle(kVehicle);
+  for (sim::QuadrotorScenario scenario : {sim::QuadrotorScenario::kHover, sim::QuadrotorScenario::kFigureEight}) {
+    sim::QuadrotorSimOptions options;
+    options.scenario = scenario;
+    options.duration_s = 4.0;
+    const sim::QuadrotorData data = sim::SimulateQuadrotor(v, options);
+    std::vector<double> times;
+    for (const auto& t : data.truth) times.push_back(t.t);
+    const estim::QuadrotorEstimate e =
+        estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, {}, times);
+    EXPECT_TRUE(e.converged) << e.solver_report;
+    EXPECT_EQ(e.states, e.segments * e.degree + 1);
+    const sim::QuadrotorErrors errors = sim::CompareWithTruth(e, data.truth);
+    EXPECT_EQ(errors.samples, 401);
+    EXPECT_LT(errors.rotor_error_percent.maxCoeff(), 1.0) << sim::ToString(scenario);
+    EXPECT_LT(errors.position_rmse_m, 0.01);
+    EXPECT_LT(errors.rotation_rmse_deg, 0.1);
+    // The front end's initial poses were worse than the estimate.
+    double initial_p2 = 0;
+    for (size_t i = 0; i < data.initial.size(); ++i) {
+      initial_p2 += (data.initial[i].p - data.truth[std::min(data.truth.size() - 1, static_cast<size_t>(std::lround(data.initial[i].t * 100)))].p).squaredNorm();
+    }
+    EXPECT_GT(std::sqrt(initial_p2 / data.initial.size()), 3 * errors.position_rmse_m);
+  }
+}
+
+TEST(QuadrotorEstimator, BadInputIsAnError) {
+  const estim::Vehicle v = estim::ReadVehicle(kVehicle);
+  sim::QuadrotorSimOptions options;
+  options.duration_s = 1.0;
+  sim::QuadrotorData data = sim::SimulateQuadrotor(v, options);
+  // Initial poses that do not cover the measurements.
+  std::vector<estim::PoseSample> short_initial(data.initial.begin(), data.initial.begin() + 10);
+  EXPECT_THROW(estim::EstimateQuadrotor(v, data.landmarks, data.pixels, short_initial, {}, {}), ComputeError);
+  // A landmark id outside the map.
+  auto pixels = data.pixels;
+  pixels[3].landmark = 100000;
+  EXPECT_THROW(estim::EstimateQuadrotor(v, data.landmarks, pixels, data.initial, {}, {}), ComputeError);
+  estim::QuadrotorEstimateOptions bad;
+  bad.degree = 1;
+  EXPECT_THROW(estim::EstimateQuadrotor(v, data.landmarks, data.pixels, data.initial, bad, {}), UsageError);
+  EXPECT_FALSE(sim::QuadrotorScenarioFromString("loop").has_value());
+}
+
+}  // namespace
+}  // namespace cheval

@@ -1,0 +1,134 @@
+// `cheval sim quadrotor` and `cheval estimate quadrotor`: the simulated quadrotor flight and the
+// pseudo-spectral estimate of its states and rotor speeds from the camera (docs/estimator.md).
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "cheval/common/error.h"
+#include "cheval/estim/quadrotor_estimator.h"
+#include "cheval/sim/quadrotor.h"
+#include "cheval/traj/io.h"
+#include "common.h"
+
+namespace cheval::cli {
+namespace {
+
+struct QuadrotorFlags {
+  std::string scenario;
+  uint64_t seed = 1;
+  double duration_s = 10.0;
+  std::string vehicle = CHEVAL_DEFAULT_VEHICLE;
+  std::string data;
+  std::string output;
+  std::string json;
+  estim::QuadrotorEstimateOptions options;
+};
+
+sim::QuadrotorSimOptions SimOptions(const QuadrotorFlags& flags) {
+  const auto scenario = sim::QuadrotorScenarioFromString(flags.scenario);
+  if (!scenario) {
+    throw UsageError(fmt::format("--scenario: unknown scenario '{}' (expected hover, line, circle, figure8, lissajous "
+                                 "or aggressive)",
+                                 flags.scenario));
+  }
+  sim::QuadrotorSimOptions options;
+  options.scenario = *scenario;
+  options.seed = flags.seed;
+  options.duration_s = flags.duration_s;
+  return options;
+}
+
+void AddSimFlags(CLI::App* command, QuadrotorFlags* flags) {
+  command->add_option("--scenario", flags->scenario, "hover|line|circle|figure8|lissajous|aggressive");
+  command->add_option("--seed", flags->seed, "Random seed (landmarks, pixel noise, front-end noise)")->capture_default_str();
+  command->add_option("--duration", flags->duration_s, "Flight duration (s)")->capture_default_str();
+  command->add_option("--vehicle", flags->vehicle, "Vehicle + camera JSON file")->capture_default_str();
+}
+
+}  // namespace
+
+void RegisterSimQuadrotor(CLI::App& app, Action* action) {
+  CLI::App* sim_command = app.get_subcommand("sim");
+  auto flags = std::make_shared<QuadrotorFlags>();
+  CLI::App* quad = sim_command->add_subcommand(
+      "quadrotor", "Quadrotor flight with motor lag, camera measurements of known landmarks and front-end poses");
+  AddSimFlags(quad, flags.get());
+  quad->get_option("--scenario")->required();
+  quad->add_option("-o,--output", flags->output, "Data folder to write")->required();
+  quad->callback([flags, action] {
+    *action = [flags] {
+      const estim::Vehicle vehicle = estim::ReadVehicle(flags->vehicle);
+      const sim::QuadrotorData data = sim::SimulateQuadrotor(vehicle, SimOptions(*flags));
+      sim::WriteQuadrotorData(data, flags->output);
+      fmt::print(stderr, "wrote {} ({} s, seed {}): {} frames, {} pixel measurements, {} landmarks, {} truth samples to {}\n",
+                 flags->scenario, flags->duration_s, flags->seed, data.initial.size(), data.pixels.size(),
+                 data.landmarks.size(), data.truth.size(), flags->output);
+    };
+  });
+}
+
+void RegisterEstimate(CLI::App& app, Action* action) {
+  CLI::App* estimate = app.add_subcommand("estimate", "Pseudo-spectral continuous-time state and dynamics estimation");
+  estimate->require_subcommand(1);
+  auto flags = std::make_shared<QuadrotorFlags>();
+  CLI::App* quad = estimate->add_subcommand(
+      "quadrotor", "States and rotor speeds of a quadrotor from camera measurements and its dynamics");
+  AddSimFlags(quad, flags.get());
+  quad->add_option("--data", flags->data,
+                   "Data folder (as written by `cheval sim quadrotor`) instead of --scenario; its vehicle.json is used "
+                   "unless --vehicle is given");
+  quad->add_option("--degree", flags->options.degree, "Polynomial degree per segment")->capture_default_str();
+  quad->add_option("--segment", flags->options.segment_s, "Segment length (s)")->capture_default_str();
+  quad->add_option("--json", flags->json, "Write the result as JSON");
+  quad->callback([flags, action, quad] {
+    const bool has_scenario = quad->get_option("--scenario")->count() > 0;
+    const bool has_data = quad->get_option("--data")->count() > 0;
+    const bool has_vehicle = quad->get_option("--vehicle")->count() > 0;
+    *action = [flags, has_scenario, has_data, has_vehicle] {
+      if (has_scenario == has_data) throw UsageError("give exactly one of --scenario NAME or --data DIR");
+      sim::QuadrotorData data;
+      if (has_data) {
+        data = sim::ReadQuadrotorData(flags->data);
+        // An explicit --vehicle replaces the folder's vehicle.json (e.g. to study a wrong model).
+        if (has_vehicle) data.vehicle = estim::ReadVehicle(flags->vehicle);
+      } else {
+        data = sim::SimulateQuadrotor(estim::ReadVehicle(flags->vehicle), SimOptions(*flags));
+      }
+      std::vector<double> times;
+      for (const sim::QuadrotorTruth& t : data.truth) times.push_back(t.t);
+      const estim::QuadrotorEstimate e =
+          estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, flags->options, times);
+      fmt::print("states              {}\nsegments            {}\ndegree              {}\n", e.states, e.segments,
+                 e.degree);
+      fmt::print("solver iterations   {}{}\nseconds             {:.3f}\n", e.iterations,
+                 e.converged ? "" : "  (did not converge)", e.seconds);
+      nlohmann::json j = {{"states", e.states},     {"segments", e.segments},   {"degree", e.degree},
+                          {"iterations", e.iterations}, {"seconds", e.seconds}, {"converged", e.converged}};
+      if (!data.truth.empty()) {
+        const sim::QuadrotorErrors errors = sim::CompareWithTruth(e, data.truth);
+        fmt::print("rotor error rpm     {:.2f} {:.2f} {:.2f} {:.2f}\n", errors.rotor_error_rpm[0],
+                   errors.rotor_error_rpm[1], errors.rotor_error_rpm[2], errors.rotor_error_rpm[3]);
+        fmt::print("rotor error %       {:.3f} {:.3f} {:.3f} {:.3f}\n", errors.rotor_error_percent[0],
+                   errors.rotor_error_percent[1], errors.rotor_error_percent[2], errors.rotor_error_percent[3]);
+        fmt::print("position RMSE       {:.4f} m\nrotation RMSE       {:.3f} deg\nvelocity RMSE       {:.4f} m/s\n",
+                   errors.position_rmse_m, errors.rotation_rmse_deg, errors.velocity_rmse_mps);
+        j["rotor_error_rpm"] = {errors.rotor_error_rpm[0], errors.rotor_error_rpm[1], errors.rotor_error_rpm[2],
+                                errors.rotor_error_rpm[3]};
+        j["rotor_error_percent"] = {errors.rotor_error_percent[0], errors.rotor_error_percent[1],
+                                    errors.rotor_error_percent[2], errors.rotor_error_percent[3]};
+        j["position_rmse_m"] = errors.position_rmse_m;
+        j["rotation_rmse_deg"] = errors.rotation_rmse_deg;
+        j["velocity_rmse_mps"] = errors.velocity_rmse_mps;
+      } else {
+        fmt::print("(no truth.csv: no errors)\n");
+      }
+      if (!e.converged) fmt::print(stderr, "cheval: warning: the solver did not converge: {}\n", e.solver_report);
+      if (!flags->json.empty()) traj::WriteFileAtomically(flags->json, j.dump(2) + "\n");
+    };
+  });
+}
+
+}  // namespace cheval::cli
