@@ -14,6 +14,7 @@
 
 #include <Eigen/Geometry>
 
+#include "cheval/cheb/model.h"
 #include "cheval/common/error.h"
 #include "cheval/traj/io.h"
 #include "cheval/traj/stamp.h"
@@ -365,6 +366,54 @@ std::optional<std::string> CheckStampInput(std::string_view data) {
                   (require_integer ? ", require_integer" : "");
   }
   return violation;
+}
+
+std::optional<std::string> CheckModelInput(std::string_view data) {
+  const std::string path = "fuzz.json";
+  cheb::TrajectoryModel model;
+  try {
+    model = cheb::ParseModelJson(data, path);
+  } catch (const InputError& e) {
+    if (std::string_view(e.what()).substr(0, path.size() + 1) != path + ":") {
+      return Describe("the InputError begins with the path", __LINE__, e.what());
+    }
+    return std::nullopt;
+  }
+  const std::string text = cheb::WriteModelJson(model);
+  std::string again;
+  try {
+    again = cheb::WriteModelJson(cheb::ParseModelJson(text, path));
+  } catch (const InputError& e) {
+    return Describe("a written model reads back", __LINE__, e.what());
+  }
+  if (again != text) return Describe("write -> read -> write gives the same text", __LINE__);
+  // CurveFromModel throws std::invalid_argument for an inconsistent model: that escapes as a bug.
+  const cheb::Curve curve = cheb::CurveFromModel(model);
+  bool moderate = true;  // every number small enough that its polynomials cannot overflow
+  for (const cheb::ModelSegment& segment : model.segments) {
+    for (const cheb::ModelWindow& window : segment.windows) {
+      for (double end : {window.core_begin, window.core_end, window.fit_begin, window.fit_end}) {
+        moderate = moderate && std::abs(end) < 1e100;
+      }
+      for (const Eigen::VectorXd& values : window.values) moderate = moderate && values.cwiseAbs().maxCoeff() < 1e100;
+    }
+  }
+  Eigen::VectorXd value(model.dimension);
+  for (const cheb::ModelSegment& segment : model.segments) {
+    const int64_t middle = segment.first_ns + (segment.last_ns - segment.first_ns) / 2;
+    for (const int64_t stamp : {segment.first_ns, middle, segment.last_ns}) {
+      try {
+        curve.EvaluateValue(stamp, value);
+      } catch (const ComputeError& e) {
+        return Describe("the curve evaluates inside its segments", __LINE__,
+                        "stamp " + std::to_string(stamp) + ": " + e.what());
+      }
+      if (moderate && !value.allFinite()) {
+        return Describe("finite values from moderate numbers", __LINE__, "stamp " + std::to_string(stamp));
+      }
+    }
+  }
+  return std::nullopt;
 }
 
 }  // namespace cheval::fuzz

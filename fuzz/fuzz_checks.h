@@ -50,4 +50,11 @@ std::optional<std::string> CheckTrajectoryInput(std::string_view target, std::st
 /// bytes are skipped. Returns nullopt or a description of the violated property, with the text.
 std::optional<std::string> CheckStampInput(std::string_view data);
 
+/// Runs the model target on `data` (a `cheval compress` model file's text, docs/compress.md): either
+/// cheb::ParseModelJson throws InputError whose message begins with `fuzz.json:`, or the model
+/// written back (WriteModelJson) reads back to the same text, CurveFromModel accepts it, and the
+/// curve evaluates at every segment's ends and middle (finite values when every stored value and
+/// interval end is below 1e100 in magnitude). Returns nullopt or the violated property.
+std::optional<std::string> CheckModelInput(std::string_view data);
+
 }  // namespace cheval::fuzz

@@ -29,6 +29,7 @@ namespace fs = std::filesystem;
 std::vector<std::string> Targets() {
   std::vector<std::string> targets(cheval::fuzz::kTrajectoryTargets.begin(), cheval::fuzz::kTrajectoryTargets.end());
   targets.push_back("stamp");
+  targets.push_back("model");
   return targets;
 }
 
@@ -67,9 +68,10 @@ TEST_P(FuzzRegressionTest, ParsesWithPropertiesOrThrowsInputError) {
   const FuzzInput& input = GetParam();
   const std::string bytes = ReadBytes(input.file);
   // Any exception that is not a cheval::Error escapes and fails the test, as it crashes the target.
-  const std::optional<std::string> violation = input.target == "stamp"
-                                                   ? cheval::fuzz::CheckStampInput(bytes)
-                                                   : cheval::fuzz::CheckTrajectoryInput(input.target, bytes);
+  const std::optional<std::string> violation =
+      input.target == "stamp"   ? cheval::fuzz::CheckStampInput(bytes)
+      : input.target == "model" ? cheval::fuzz::CheckModelInput(bytes)
+                                : cheval::fuzz::CheckTrajectoryInput(input.target, bytes);
   EXPECT_EQ(violation, std::nullopt) << input.file;
 }
 
