@@ -45,5 +45,7 @@ void RegisterAse(CLI::App& app, Action* action);
 /// `cheval sim quadrotor` (needs RegisterSim first) and `cheval estimate quadrotor` (tools/cheval/quadrotor.cc).
 void RegisterSimQuadrotor(CLI::App& app, Action* action);
 void RegisterEstimate(CLI::App& app, Action* action);
+/// `cheval estimate thrust` (needs RegisterEstimate first; tools/cheval/estimate_thrust.cc).
+void RegisterEstimateThrust(CLI::App& app, Action* action);
 
 }  // namespace cheval::cli

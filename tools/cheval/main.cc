@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   cheval::cli::RegisterAse(app, &action);
   cheval::cli::RegisterSimQuadrotor(app, &action);
   cheval::cli::RegisterEstimate(app, &action);
+  cheval::cli::RegisterEstimateThrust(app, &action);
 
   auto fail = [](ExitCode code, const std::string& message) {
     std::fprintf(stderr, "%s\n", message.c_str());
