@@ -29,9 +29,12 @@ constexpr int kVersion = 1;
 // (about 104 days): a model may span no more than that from its origin.
 constexpr int64_t kMaxSpanNs = int64_t{1} << 53;
 
-// A finite double in the shortest form that reads back to the same double (fmt's default).
+// A finite double in the shortest form that reads back to the same double (fmt's default). fmt
+// writes -0.0 as "-0", which JSON readers take for the integer 0: write it as "-0.0" (found by
+// fuzz_model; tests/data/fuzz/model/negative_zero_value.json).
 std::string Number(double x) {
   if (!std::isfinite(x)) throw std::invalid_argument("WriteModelJson: non-finite number in the model");
+  if (x == 0 && std::signbit(x)) return "-0.0";
   return fmt::format("{}", x);
 }
 
@@ -130,7 +133,8 @@ class ModelReader {
   }
 
   void CheckKeys(const Json& object, const std::string& where, std::initializer_list<const char*> allowed) const {
-    for (const auto& [key, value] : object.items()) {
+    for (const auto& item : object.items()) {
+      const std::string& key = item.key();  // not a structured binding: clang 14 cannot capture one
       if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; }) == allowed.end()) {
         std::string names;
         for (const char* a : allowed) names += (names.empty() ? "" : ", ") + std::string(a);
