@@ -9,15 +9,7 @@ void RegisterAse(CLI::App& app, Action* action) {
       app, action, eval::MetricKind::kAse,
       "Absolute state error on SE_2(3): rotation, position and velocity in one number (C-ASE)",
       [](CLI::App* command, EvalFlags* flags) {
-        command->add_option("--gt-velocity", flags->gt_velocity,
-                            "Reference velocity: given (its columns), chebyshev or central (from its positions); "
-                            "auto = given if present, else chebyshev")
-            ->check(CLI::IsMember({"auto", "given", "chebyshev", "central"}))
-            ->capture_default_str();
-        command->add_option("--velocity-frame", flags->velocity_frame,
-                            "Frame of the estimate's velocity columns; body is rotated by the estimate's orientation")
-            ->check(CLI::IsMember({"world", "body"}))
-            ->capture_default_str();
+        AddStateVelocityFlags(command, flags);
         command->add_flag("--pose-only", flags->pose_only,
                           "Pose-only ASE (rotation + position) for estimates without velocity");
       });

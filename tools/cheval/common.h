@@ -42,6 +42,8 @@ void RegisterSample(CLI::App& app, Action* action);
 void RegisterApe(CLI::App& app, Action* action);
 void RegisterRpe(CLI::App& app, Action* action);
 void RegisterAse(CLI::App& app, Action* action);
+/// `cheval report REF EST [EST2 ...] -o report.html` (tools/cheval/report.cc).
+void RegisterReport(CLI::App& app, Action* action);
 /// `cheval sim quadrotor` (needs RegisterSim first) and `cheval estimate quadrotor` (tools/cheval/quadrotor.cc).
 void RegisterSimQuadrotor(CLI::App& app, Action* action);
 void RegisterEstimate(CLI::App& app, Action* action);

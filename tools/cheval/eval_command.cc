@@ -35,7 +35,9 @@ eval::DeltaUnit ParseDeltaUnit(const std::string& name) {
   return *eval::DeltaUnitFromString(name);
 }
 
-eval::EvaluationOptions ToOptions(eval::MetricKind metric, const EvalFlags& flags) {
+}  // namespace
+
+eval::EvaluationOptions ToEvaluationOptions(eval::MetricKind metric, const EvalFlags& flags) {
   eval::EvaluationOptions options;
   options.metric = metric;
   options.association.max_diff_ns = eval::SecondsToNanoseconds(flags.t_max_diff, "--t-max-diff");
@@ -54,6 +56,22 @@ eval::EvaluationOptions ToOptions(eval::MetricKind metric, const EvalFlags& flag
   eval::ValidateEvaluationOptions(options);
   return options;
 }
+
+EvalInputs ReadEvalInputs(CLI::App* command, const EvalFlags& flags) {
+  const traj::ReadOptions ref_options = SideOptions(command, flags, "ref-", flags.ref);
+  const traj::ReadOptions est_options = SideOptions(command, flags, "est-", flags.est);
+  // Read the files concurrently (reading dominates the run time); errors are reported in argument order.
+  auto ref_future = std::async(std::launch::async, [&] { return traj::ReadTrajectory(flags.reference, ref_options); });
+  std::vector<std::future<traj::Trajectory>> est_futures;
+  for (const std::string& path : flags.estimates) {
+    est_futures.push_back(std::async(std::launch::async, [&, path] { return traj::ReadTrajectory(path, est_options); }));
+  }
+  EvalInputs inputs{ref_future.get(), {}};
+  for (auto& f : est_futures) inputs.estimates.push_back(f.get());
+  return inputs;
+}
+
+namespace {
 
 // evo's statistics in its order (sorted by name).
 std::vector<std::pair<std::string, double>> SortedStats(const eval::ErrorStatistics& s) {
@@ -147,18 +165,10 @@ std::string ErrorsCsv(const std::vector<Evaluated>& all, eval::MetricKind metric
 }
 
 void Run(CLI::App* command, eval::MetricKind metric, const EvalFlags& flags) {
-  const eval::EvaluationOptions options = ToOptions(metric, flags);
-  const traj::ReadOptions ref_options = SideOptions(command, flags, "ref-", flags.ref);
-  const traj::ReadOptions est_options = SideOptions(command, flags, "est-", flags.est);
-  // Read the files concurrently (reading dominates the run time); errors are reported in argument order.
-  auto ref_future = std::async(std::launch::async, [&] { return traj::ReadTrajectory(flags.reference, ref_options); });
-  std::vector<std::future<traj::Trajectory>> est_futures;
-  for (const std::string& path : flags.estimates) {
-    est_futures.push_back(std::async(std::launch::async, [&, path] { return traj::ReadTrajectory(path, est_options); }));
-  }
-  const traj::Trajectory ref = ref_future.get();
-  std::vector<traj::Trajectory> ests;
-  for (auto& f : est_futures) ests.push_back(f.get());
+  const eval::EvaluationOptions options = ToEvaluationOptions(metric, flags);
+  const EvalInputs inputs = ReadEvalInputs(command, flags);
+  const traj::Trajectory& ref = inputs.reference;
+  const std::vector<traj::Trajectory>& ests = inputs.estimates;
 
   // Everything is evaluated before anything is written or printed: an error leaves no output file.
   std::vector<Evaluated> all;
@@ -192,10 +202,7 @@ void AddRelationFlag(CLI::App* command, EvalFlags* flags) {
       ->capture_default_str();
 }
 
-void RegisterEvalCommand(CLI::App& app, Action* action, eval::MetricKind metric, const std::string& description,
-                         const std::function<void(CLI::App*, EvalFlags*)>& add_flags) {
-  auto flags = std::make_shared<EvalFlags>();
-  CLI::App* command = app.add_subcommand(std::string(eval::ToString(metric)), description);
+void AddEvalInputFlags(CLI::App* command, EvalFlags* flags) {
   command->add_option("reference", flags->reference, "Reference (ground-truth) trajectory file")->required();
   command->add_option("estimates", flags->estimates, "One or more estimated trajectory files")->required();
   AddInputFlags(command, &flags->both);
@@ -214,6 +221,25 @@ void RegisterEvalCommand(CLI::App& app, Action* action, eval::MetricKind metric,
                       "Chebyshev curve evaluated at the exact estimate stamps")
       ->check(CLI::IsMember({"nearest", "continuous"}))
       ->capture_default_str();
+}
+
+void AddStateVelocityFlags(CLI::App* command, EvalFlags* flags) {
+  command->add_option("--gt-velocity", flags->gt_velocity,
+                      "Reference velocity: given (its columns), chebyshev or central (from its positions); "
+                      "auto = given if present, else chebyshev")
+      ->check(CLI::IsMember({"auto", "given", "chebyshev", "central"}))
+      ->capture_default_str();
+  command->add_option("--velocity-frame", flags->velocity_frame,
+                      "Frame of the estimate's velocity columns; body is rotated by the estimate's orientation")
+      ->check(CLI::IsMember({"world", "body"}))
+      ->capture_default_str();
+}
+
+void RegisterEvalCommand(CLI::App& app, Action* action, eval::MetricKind metric, const std::string& description,
+                         const std::function<void(CLI::App*, EvalFlags*)>& add_flags) {
+  auto flags = std::make_shared<EvalFlags>();
+  CLI::App* command = app.add_subcommand(std::string(eval::ToString(metric)), description);
+  AddEvalInputFlags(command, flags.get());
   command->add_option("--json", flags->json_path, "Write the result as JSON (an array for several estimates)");
   command->add_option("--errors", flags->errors_path, "Write the per-pair errors as CSV");
   add_flags(command, flags.get());

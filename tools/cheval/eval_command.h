@@ -39,6 +39,27 @@ struct EvalFlags {
 /// Adds `-r,--relation` (APE and RPE).
 void AddRelationFlag(CLI::App* command, EvalFlags* flags);
 
+/// Adds the arguments and flags every evaluation command takes (also `cheval report`): the reference
+/// and estimate files, the input flags for both and per side, --align (its default is the current
+/// value of flags->align), --n-align, --t-max-diff, --t-offset, --association.
+void AddEvalInputFlags(CLI::App* command, EvalFlags* flags);
+
+/// Adds the ASE's velocity flags --gt-velocity and --velocity-frame.
+void AddStateVelocityFlags(CLI::App* command, EvalFlags* flags);
+
+/// The library options of an evaluation of `metric` from the flags; UsageError on a bad combination.
+eval::EvaluationOptions ToEvaluationOptions(eval::MetricKind metric, const EvalFlags& flags);
+
+/// The files of an evaluation, read.
+struct EvalInputs {
+  traj::Trajectory reference;
+  std::vector<traj::Trajectory> estimates;
+};
+
+/// Reads the reference and the estimates concurrently with the read options of each side (errors
+/// are reported in argument order).
+EvalInputs ReadEvalInputs(CLI::App* command, const EvalFlags& flags);
+
 /// Registers the evaluation subcommand of `metric` (named by eval::ToString): the flags every
 /// evaluation command has, the metric's own flags added by `add_flags`, and the action.
 void RegisterEvalCommand(CLI::App& app, Action* action, eval::MetricKind metric, const std::string& description,

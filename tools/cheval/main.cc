@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   cheval::cli::RegisterApe(app, &action);
   cheval::cli::RegisterRpe(app, &action);
   cheval::cli::RegisterAse(app, &action);
+  cheval::cli::RegisterReport(app, &action);
   cheval::cli::RegisterSimQuadrotor(app, &action);
   cheval::cli::RegisterEstimate(app, &action);
   cheval::cli::RegisterEstimateThrust(app, &action);

@@ -1,0 +1,85 @@
+#pragma once
+/// \file
+/// The HTML report of `cheval report REF EST [EST2 ...]` (docs/report.md): one self-contained page
+/// (chart library, page script, styles and data inlined) with the aligned trajectories, APE and ASE
+/// over time, the reference velocity (Chebyshev and central differences, and its own columns)
+/// against each estimate's, the comparison table, and the diagnostics of the reference's Chebyshev
+/// fit. BuildReport computes everything the page shows (the statistics from all pairs; the plotted
+/// series decimated, decimate.h); RenderReportHtml writes the page around it.
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cheval/eval/evaluate.h"
+#include "cheval/traj/trajectory.h"
+
+namespace cheval::report {
+
+/// A trajectory of the report with the name the page shows (its file path).
+struct ReportInput {
+  std::string path;
+  traj::TrajectoryView trajectory;
+};
+
+/// Options of BuildReport.
+struct ReportOptions {
+  /// The APE's options (relation, association, alignment); its metric is ignored.
+  eval::EvaluationOptions ape;
+  /// The ASE's options (reference velocity source, estimate velocity frame, the same association and
+  /// alignment); its metric is ignored.
+  eval::EvaluationOptions ase;
+  /// The association's largest stamp difference and offset in seconds as the caller gave them (the
+  /// embedded results repeat them, as `cheval ape --json` does).
+  double max_diff_s = 0.01;
+  double offset_s = 0.0;
+  /// Most points of one plotted series (min/max buckets for series over time, a stride for paths).
+  std::size_t max_points = 5000;
+  /// Most windows of the reference's Chebyshev fit whose coefficient magnitudes are embedded (evenly
+  /// spread over the windows; the degrees of every window are embedded).
+  std::size_t max_fit_windows = 64;
+  /// Shown in the page's footer, e.g. "cheval 0.1.0".
+  std::string generator;
+};
+
+/// What BuildReport computed.
+struct Report {
+  /// Per estimate, its APE, and its ASE when it has velocity and the ASE can be computed (nullopt
+  /// otherwise), from all pairs:
+  /// the same results `cheval ape|ase --json` writes with the same options.
+  std::vector<eval::EvaluationReport> ape;
+  std::vector<std::optional<eval::EvaluationReport>> ase;
+  /// Why something is not shown (an estimate without velocity, a reference without stamps, ...).
+  std::vector<std::string> notes;
+  /// The page's data (JSON, docs/report.md "Embedded data"): version, inputs, options, the APE and
+  /// ASE results exactly as `cheval ape|ase --json` writes them, the decimated series, the fit
+  /// diagnostics, the notes.
+  std::string data_json;
+};
+
+/// Evaluates every estimate against the reference (APE; ASE where the estimate has velocity) and
+/// gathers the series the page plots. Throws what eval::Evaluate throws for the APE (the errors of
+/// `cheval ape`, e.g. ComputeError when no pair is found), UsageError for bad options (also the
+/// ASE's) and for max_points < 16 or max_fit_windows < 1. What can be computed for the charts alone
+/// becomes a note instead of an error: an estimate without velocity, an ASE that is impossible where
+/// the APE is not (ComputeError, e.g. a reference without stamps to derive its velocity from, or
+/// --gt-velocity given on a reference without velocity), a reference velocity or fit that cannot be
+/// computed (no stamps, too few samples).
+Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>& estimates,
+                   const ReportOptions& options);
+
+/// True when this build embeds the page's chart library (CMake option CHEVAL_BUILD_REPORT).
+bool ReportPageAvailable();
+
+/// Throws UsageError naming the CMake option when !ReportPageAvailable() (a caller checks this
+/// before any work).
+void RequireReportPage();
+
+/// The HTML page around BuildReport's data_json: the chart library's script and styles, the page's
+/// own script and styles and the data, all inline; `title` (plain text) is escaped. Throws
+/// UsageError when !ReportPageAvailable(), naming the CMake option.
+std::string RenderReportHtml(std::string_view data_json, std::string_view title);
+
+}  // namespace cheval::report

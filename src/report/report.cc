@@ -1,0 +1,330 @@
+#include "cheval/report/report.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <numeric>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "cheval/common/error.h"
+#include "cheval/eval/pairs.h"
+#include "cheval/eval/velocity.h"
+#include "cheval/report/decimate.h"
+
+namespace cheval::report {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+// A plotted value with `digits` significant digits: its shortest form is then short (the page draws
+// pixels; the statistics are embedded at full precision). Not finite -> NaN, which the JSON writes
+// as null (a gap).
+double Rounded(double value, int digits = 6) {
+  if (!std::isfinite(value)) return std::nan("");
+  char text[32];
+  const auto written = std::to_chars(text, text + sizeof text, value, std::chars_format::general, digits);
+  double rounded = value;
+  std::from_chars(text, written.ptr, rounded);
+  return rounded;
+}
+
+// Seconds from the report's time origin, to the microsecond.
+double SecondsFrom(int64_t origin_ns, int64_t stamp_ns) {
+  return std::round(static_cast<double>(stamp_ns - origin_ns) / 1e3) / 1e6;  // divisions: the nearest double
+}
+
+// A series over time for the page: {"t": [...], name: [...], ...}, sorted by time, decimated by
+// min/max buckets over all columns together (MinMaxDecimation).
+Json TimeSeries(const std::vector<double>& t, const std::vector<std::pair<std::string, std::vector<double>>>& columns,
+                std::size_t max_points) {
+  std::vector<Eigen::Index> order(t.size());
+  std::iota(order.begin(), order.end(), Eigen::Index{0});
+  std::stable_sort(order.begin(), order.end(), [&](Eigen::Index a, Eigen::Index b) { return t[a] < t[b]; });
+  std::vector<std::vector<double>> sorted;
+  for (const auto& column : columns) {
+    std::vector<double>& s = sorted.emplace_back(order.size());
+    for (size_t i = 0; i < order.size(); ++i) s[i] = column.second[static_cast<size_t>(order[i])];
+  }
+  const std::vector<std::span<const double>> views(sorted.begin(), sorted.end());
+  const std::vector<Eigen::Index> kept = MinMaxDecimation(views, max_points);
+  Json series;
+  Json& times = series["t"] = Json::array();
+  for (Eigen::Index i : kept) times.push_back(t[static_cast<size_t>(order[static_cast<size_t>(i)])]);
+  for (size_t c = 0; c < columns.size(); ++c) {
+    Json& values = series[columns[c].first] = Json::array();
+    for (Eigen::Index i : kept) values.push_back(Rounded(sorted[c][static_cast<size_t>(i)]));
+  }
+  series["n"] = t.size();  // samples before decimation
+  return series;
+}
+
+// Columns vx, vy, vz and speed of 3 x n velocities.
+std::vector<std::pair<std::string, std::vector<double>>> VelocityColumns(const Eigen::Ref<const Eigen::Matrix3Xd>& v) {
+  std::vector<std::pair<std::string, std::vector<double>>> columns = {
+      {"vx", {}}, {"vy", {}}, {"vz", {}}, {"speed", {}}};
+  for (Eigen::Index i = 0; i < v.cols(); ++i) {
+    for (int axis = 0; axis < 3; ++axis) columns[axis].second.push_back(v(axis, i));
+    columns[3].second.push_back(v.col(i).norm());
+  }
+  return columns;
+}
+
+// A path in space for the page, {"x": [...], "y": [...], "z": [...]}, decimated by a stride
+// (StrideDecimation): a path has no value whose extremes a user looks for.
+Json Path(const Eigen::Ref<const Eigen::Matrix3Xd>& positions, std::size_t max_points) {
+  Json path;
+  const char* names[3] = {"x", "y", "z"};
+  const std::vector<Eigen::Index> kept = StrideDecimation(positions.cols(), max_points);
+  for (int axis = 0; axis < 3; ++axis) {
+    Json& values = path[names[axis]] = Json::array();
+    for (Eigen::Index i : kept) values.push_back(Rounded(positions(axis, i)));
+  }
+  path["n"] = positions.cols();
+  return path;
+}
+
+// The report's clock: seconds from the reference's first stamp, or the pose index without stamps.
+struct Clock {
+  bool stamps = true;
+  int64_t origin_ns = 0;
+
+  // Times of the poses of a trajectory whose stamps plus `offset_ns` are reference stamps.
+  std::vector<double> Poses(const traj::TrajectoryView& trajectory, int64_t offset_ns = 0) const {
+    std::vector<double> t(static_cast<size_t>(trajectory.size()));
+    for (Eigen::Index i = 0; i < trajectory.size(); ++i) {
+      t[static_cast<size_t>(i)] = stamps && trajectory.has_stamps()
+                                      ? SecondsFrom(origin_ns, trajectory.stamps_ns()[i] + offset_ns)
+                                      : static_cast<double>(i);
+    }
+    return t;
+  }
+  // Times of the pairs of a result: the paired reference stamps.
+  std::vector<double> Pairs(const eval::EvaluationResult& result, const traj::TrajectoryView& ref) const {
+    const traj::TrajectoryView paired = result.continuous_reference ? result.continuous_reference->View() : ref;
+    std::vector<double> t(static_cast<size_t>(result.association.size()));
+    for (size_t k = 0; k < t.size(); ++k) {
+      t[k] = stamps ? SecondsFrom(origin_ns, paired.stamps_ns()[result.association.ref[k]]) : static_cast<double>(k);
+    }
+    return t;
+  }
+};
+
+// The estimate's states with an alignment applied, every pose (not only the paired ones).
+struct AlignedStates {
+  Eigen::Matrix3Xd positions, velocities;
+};
+
+AlignedStates Aligned(const traj::TrajectoryView& est, const eval::Similarity& alignment, bool velocity,
+                      bool body_frame) {
+  eval::Association all;
+  all.ref.resize(static_cast<size_t>(est.size()));
+  std::iota(all.ref.begin(), all.ref.end(), Eigen::Index{0});
+  all.est = all.ref;
+  eval::PairedStates states(est, est, all);
+  if (velocity) states.SetEstimateVelocityInBodyFrame(body_frame);
+  states.SetAlignment(alignment);
+  AlignedStates out{Eigen::Matrix3Xd(3, est.size()), Eigen::Matrix3Xd(3, velocity ? est.size() : 0)};
+  for (Eigen::Index k = 0; k < est.size(); ++k) {
+    out.positions.col(k) = states.EstimatePosition(k);
+    if (velocity) out.velocities.col(k) = states.EstimateVelocity(k);
+  }
+  return out;
+}
+
+eval::EvaluationReport Evaluated(const ReportInput& reference, const ReportInput& estimate,
+                                 const eval::EvaluationOptions& evaluation, eval::MetricKind metric,
+                                 const ReportOptions& options) {
+  eval::EvaluationReport e;
+  e.reference_path = reference.path;
+  e.reference_poses = reference.trajectory.size();
+  e.estimate_path = estimate.path;
+  e.estimate_poses = estimate.trajectory.size();
+  e.max_diff_s = options.max_diff_s;
+  e.offset_s = options.offset_s;
+  e.options = evaluation;
+  e.options.metric = metric;
+  e.result = eval::Evaluate(reference.trajectory, estimate.trajectory, e.options);
+  return e;
+}
+
+// The result exactly as `cheval ape|ase --json` writes it for this one estimate.
+Json ResultJson(const eval::EvaluationReport& report) {
+  return Json::parse(eval::EvaluationJson(std::span<const eval::EvaluationReport>(&report, 1)));
+}
+
+// The diagnostics of the reference's Chebyshev fit: every window's interval, samples and degrees;
+// the coefficient magnitudes of up to max_windows windows spread evenly; σ and the residual.
+Json FitDiagnostics(const cheb::Curve& curve, const Clock& clock, std::size_t max_windows) {
+  const double shift = clock.stamps ? static_cast<double>(curve.origin_ns() - clock.origin_ns) * 1e-9 : 0.0;
+  Json windows = Json::array();
+  std::vector<const cheb::CurveWindow*> all;
+  for (size_t s = 0; s < curve.segments().size(); ++s) {
+    for (const cheb::CurveWindow& w : curve.segments()[s].windows) {
+      windows.push_back({{"segment", s},
+                         {"begin", Rounded(w.fit_begin + shift, 9)},
+                         {"end", Rounded(w.fit_end + shift, 9)},
+                         {"core_begin", Rounded(w.core_begin + shift, 9)},
+                         {"core_end", Rounded(w.core_end + shift, 9)},
+                         {"samples", w.samples},
+                         {"degrees", w.degrees}});
+      all.push_back(&w);
+    }
+  }
+  Json coefficients = Json::array();
+  const size_t shown = std::min(all.size(), max_windows);
+  for (size_t i = 0; i < shown; ++i) {
+    const size_t index = shown == 1 ? 0 : (i * (all.size() - 1) + (shown - 1) / 2) / (shown - 1);
+    const cheb::CurveWindow& w = *all[index];
+    Json magnitudes = Json::array();
+    for (Eigen::Index c = 0; c < w.coefficient_magnitudes.cols(); ++c) {
+      Json column = Json::array();
+      for (Eigen::Index k = 0; k < w.coefficient_magnitudes.rows(); ++k) {
+        column.push_back(Rounded(w.coefficient_magnitudes(k, c), 4));
+      }
+      magnitudes.push_back(column);
+    }
+    // White noise of σ on m samples puts the coefficients of a least-squares fit at about σ·sqrt(2/m).
+    Json noise = Json::array();
+    for (Eigen::Index c = 0; c < curve.noise_sigma().size(); ++c) {
+      noise.push_back(Rounded(
+          curve.noise_sigma()[c] * std::sqrt(2.0 / static_cast<double>(std::max<Eigen::Index>(w.samples, 1))), 4));
+    }
+    coefficients.push_back({{"window", index}, {"magnitudes", magnitudes}, {"noise_level", noise}});
+  }
+  const auto& sigma = curve.noise_sigma();
+  const auto& residual = curve.residual_rms();
+  return Json{{"segments", curve.segments().size()},
+              {"windows", windows},
+              {"coefficients", coefficients},
+              {"noise_sigma", std::vector<double>(sigma.data(), sigma.data() + sigma.size())},
+              {"residual_rms", std::vector<double>(residual.data(), residual.data() + residual.size())}};
+}
+
+// The reference's velocity three ways and its Chebyshev fit; what cannot be computed is a note.
+Json ReferenceVelocity(const ReportInput& reference, const ReportOptions& options, const Clock& clock,
+                       std::vector<std::string>* notes, Json* fit) {
+  const traj::TrajectoryView& ref = reference.trajectory;
+  Json velocity = Json::object();
+  if (!ref.has_stamps()) {
+    notes->push_back(fmt::format("{} has no stamps: its velocity from positions and the Chebyshev fit are not shown",
+                                 reference.path));
+    return velocity;
+  }
+  const std::vector<double> t = clock.Poses(ref);
+  const std::pair<eval::VelocityMethod, const char*> methods[] = {{eval::VelocityMethod::kChebyshev, "chebyshev"},
+                                                                  {eval::VelocityMethod::kCentral, "central"}};
+  for (const auto& [method, name] : methods) {
+    eval::VelocityOptions velocity_options = options.ase.velocity;
+    velocity_options.method = method;
+    velocity_options.angular = false;
+    try {
+      const eval::VelocityEstimate estimate = eval::EstimateVelocity(ref, velocity_options);
+      velocity[name] = TimeSeries(t, VelocityColumns(estimate.velocities), options.max_points);
+      if (estimate.curve) *fit = FitDiagnostics(*estimate.curve, clock, options.max_fit_windows);
+    } catch (const ComputeError& e) {
+      notes->push_back(fmt::format("the reference velocity by {} cannot be shown: {}", name, e.what()));
+    }
+  }
+  if (ref.has_velocity()) velocity["given"] = TimeSeries(t, VelocityColumns(ref.velocities()), options.max_points);
+  return velocity;
+}
+
+}  // namespace
+
+Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>& estimates,
+                   const ReportOptions& options) {
+  if (options.max_points < 16)
+    throw UsageError(fmt::format("--max-points must be at least 16, got {}", options.max_points));
+  if (options.max_fit_windows < 1) throw UsageError("the report needs at least one fit window's coefficients");
+  const traj::TrajectoryView& ref = reference.trajectory;
+  Clock clock;
+  clock.stamps = ref.has_stamps() && !ref.empty();
+  clock.origin_ns = clock.stamps ? *std::min_element(ref.stamps_ns().begin(), ref.stamps_ns().end()) : 0;
+
+  Report report;
+  Json data;
+  data["format"] = "cheval-report";
+  data["version"] = 1;
+  data["generator"] = options.generator;
+  data["reference"] = {{"path", reference.path},
+                       {"poses", ref.size()},
+                       {"has_stamps", ref.has_stamps()},
+                       {"has_orientation", ref.has_orientation()},
+                       {"has_velocity", ref.has_velocity()},
+                       {"path_xyz", Path(ref.positions(), options.max_points)}};
+  data["time_axis"] = clock.stamps ? "s" : "index";
+  data["time_origin_ns"] = std::to_string(clock.origin_ns);  // a string: int64 does not fit a JavaScript number
+  data["options"] = {{"align", std::string(eval::ToString(options.ape.alignment.method))},
+                     {"n_align", options.ape.alignment.n_align},
+                     {"relation", std::string(eval::ToString(options.ape.relation))},
+                     {"t_max_diff", options.max_diff_s},
+                     {"t_offset", options.offset_s},
+                     {"association", options.ape.continuous_reference ? "continuous" : "nearest"},
+                     {"gt_velocity", std::string(eval::ToString(options.ase.reference_velocity))},
+                     {"velocity_frame", options.ase.estimate_velocity_body_frame ? "body" : "world"},
+                     {"max_points", options.max_points}};
+
+  Json entries = Json::array();
+  for (const ReportInput& estimate : estimates) {
+    const traj::TrajectoryView& est = estimate.trajectory;
+    const eval::EvaluationReport& ape =
+        report.ape.emplace_back(Evaluated(reference, estimate, options.ape, eval::MetricKind::kApe, options));
+    Json entry;
+    entry["path"] = estimate.path;
+    entry["poses"] = est.size();
+    entry["has_velocity"] = est.has_velocity();
+    entry["ape"] = ResultJson(ape);
+    entry["ape_series"] = TimeSeries(clock.Pairs(ape.result, ref), {{"error", ape.result.errors}}, options.max_points);
+    entry["path_xyz"] = Path(Aligned(est, ape.result.alignment.transform, false, false).positions, options.max_points);
+    std::optional<eval::EvaluationReport>& ase = report.ase.emplace_back();
+    // Why the estimate has no ASE, if it has none.
+    std::string absent;
+    if (!est.has_velocity()) {
+      absent = "no velocity";
+      report.notes.push_back(fmt::format(
+          "{} has no velocity: its ASE and velocity are not shown (give a file with velocity columns: tumv, euroc, "
+          "vins, or csv with vx,vy,vz)",
+          estimate.path));
+    } else {
+      try {
+        ase = Evaluated(reference, estimate, options.ase, eval::MetricKind::kAse, options);
+      } catch (const ComputeError& e) {
+        absent = "no ASE";
+        report.notes.push_back(fmt::format("the ASE of {} cannot be computed, so it is not shown: {}", estimate.path,
+                                           e.what()));
+      }
+    }
+    if (ase) {
+      const eval::AseErrors& parts = *ase->result.ase;
+      std::vector<std::pair<std::string, std::vector<double>>> columns = {{"total", parts.total}};
+      if (parts.has_rotation) columns.push_back({"rotation", parts.rotation});
+      columns.push_back({"position", parts.position});
+      if (parts.has_velocity) columns.push_back({"velocity", parts.velocity});
+      entry["ase"] = ResultJson(*ase);
+      entry["ase_series"] = TimeSeries(clock.Pairs(ase->result, ref), columns, options.max_points);
+    } else {
+      entry["ase"] = nullptr;
+      entry["ase_absent"] = absent;
+    }
+    if (est.has_velocity()) {
+      // The velocity the ASE scored: world frame (after --velocity-frame body), with the ASE's alignment
+      // (the APE's when there is no ASE).
+      const eval::Similarity& alignment = (ase ? ase->result : ape.result).alignment.transform;
+      const AlignedStates states = Aligned(est, alignment, true, options.ase.estimate_velocity_body_frame);
+      entry["velocity"] = TimeSeries(clock.Poses(est, options.ase.association.offset_ns),
+                                     VelocityColumns(states.velocities), options.max_points);
+    }
+    entries.push_back(std::move(entry));
+  }
+  data["estimates"] = std::move(entries);
+  Json fit = nullptr;
+  data["reference_velocity"] = ReferenceVelocity(reference, options, clock, &report.notes, &fit);
+  data["fit"] = std::move(fit);
+  data["notes"] = report.notes;
+  report.data_json = data.dump();
+  return report;
+}
+
+}  // namespace cheval::report

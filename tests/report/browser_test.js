@@ -1,0 +1,166 @@
+// `cheval report` in a real browser: Debian's headless Chromium driven by playwright-core (from
+// report/package-lock.json; it never downloads a browser). Simulates a drone flight with the
+// project's own simulator, makes two estimates with velocity (a noisy 50 Hz copy with `cheval
+// velocity`, and the truth with a slow drift) and one without, writes the report and checks in the
+// browser that it loads with no console error or failed request, that every chart has data, that
+// the table shows the embedded numbers and that the missing velocity is said on the page; then
+// takes a full-page screenshot.
+//
+//   node browser_test.js CHEVAL_EXE NODE_MODULES OUTPUT_DIR
+//
+// Exit 0: passed; 1: failed; 77: skipped (no Chromium and not in CI; in CI, CI=true, a missing
+// Chromium is a failure). Chromium: $CHEVAL_CHROMIUM, else /usr/bin/chromium.
+'use strict';
+
+const { execFileSync } = require('child_process');
+const fs = require('fs');
+const os = require('os');
+const path = require('path');
+
+const [cheval, nodeModules, outputDir] = process.argv.slice(2);
+if (!cheval || !nodeModules || !outputDir) {
+  console.error('usage: node browser_test.js CHEVAL_EXE NODE_MODULES OUTPUT_DIR');
+  process.exit(1);
+}
+const chromium = process.env.CHEVAL_CHROMIUM || '/usr/bin/chromium';
+if (!fs.existsSync(chromium)) {
+  if (process.env.CI === 'true') {
+    console.error(`browser_test: error: ${chromium} not found (install the Debian packages chromium and chromium-driver: scripts/install-deps.sh)`);
+    process.exit(1);
+  }
+  console.log(`browser_test: skipped: ${chromium} not found (scripts/install-deps.sh installs it)`);
+  process.exit(77);
+}
+const { chromium: playwright } = require(path.join(nodeModules, 'playwright-core'));
+
+let failures = 0;
+function check(condition, what) {
+  if (condition) {
+    console.log(`ok: ${what}`);
+  } else {
+    console.log(`FAILED: ${what}`);
+    failures++;
+  }
+}
+
+function run(...args) {
+  return execFileSync(cheval, args, { cwd: work, encoding: 'utf8' });
+}
+
+// The truth with a slow drift and a velocity bias: a second estimate with velocity.
+function drifted(truthPath, outPath) {
+  const lines = fs.readFileSync(truthPath, 'utf8').split('\n').filter((l) => l && !l.startsWith('#'));
+  const t0 = Number(lines[0].split(/\s+/)[0]);
+  const out = lines.map((line) => {
+    const f = line.split(/\s+/);
+    const t = Number(f[0]) - t0;
+    const drift = [0.004 * t, -0.003 * t, 0.001 * t];
+    const position = [1, 2, 3].map((c, a) => (Number(f[c]) + drift[a] + 0.05 * Math.sin(0.7 * t + a)).toFixed(6));
+    const velocity = [8, 9, 10].map((c, a) => (Number(f[c]) + [0.004, -0.003, 0.001][a] + 0.035 * Math.cos(0.7 * t + a)).toFixed(6));
+    return [f[0], ...position, ...f.slice(4, 8), ...velocity].join(' ');
+  });
+  fs.writeFileSync(outPath, out.join('\n') + '\n');
+}
+
+const work = fs.mkdtempSync(path.join(os.tmpdir(), 'cheval_report_browser_'));
+const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'cheval_report_chromium_'));
+
+async function main() {
+  run('sim', 'motion', '--kind', 'drone', '--seed', '1', '--noise', '0.0005', '--duration', '60', '-o', 'mocap.tum', '--truth', 'truth.tumv');
+  run('sim', 'motion', '--kind', 'drone', '--seed', '1', '--noise', '0.01', '--rotation-noise', '0.003', '--duration', '60',
+    '--rate', '50', '-o', 'noisy.tum');
+  run('velocity', 'noisy.tum', '-o', 'noisy_velocity.tumv');
+  drifted(path.join(work, 'truth.tumv'), path.join(work, 'drifting.tumv'));
+  run('sim', 'motion', '--kind', 'drone', '--seed', '1', '--noise', '0.03', '--duration', '60', '--rate', '20', '-o', 'poses_only.tum');
+  const printed = run('report', 'mocap.tum', 'noisy_velocity.tumv', 'drifting.tumv', 'poses_only.tum', '-o', 'report.html');
+  process.stdout.write(printed);
+  const page = path.join(work, 'report.html');
+
+  // A fresh profile (Playwright passes it as --user-data-dir).
+  const context = await playwright.launchPersistentContext(profile, {
+    executablePath: chromium,
+    headless: true,
+    args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
+      '--disable-component-update', '--disable-sync'],
+    viewport: { width: 1400, height: 900 },
+    deviceScaleFactor: 1,
+  });
+  try {
+    const tab = await context.newPage();
+    const problems = [];
+    tab.on('console', (m) => { if (m.type() === 'error' || m.type() === 'warning') problems.push(`console ${m.type()}: ${m.text()}`); });
+    tab.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
+    // A self-contained page requests nothing but itself.
+    tab.on('request', (r) => { if (!r.url().startsWith('file://')) problems.push(`request: ${r.url()}`); });
+    tab.on('requestfailed', (r) => problems.push(`request failed: ${r.url()}`));
+    await tab.goto('file://' + page);
+    await tab.waitForSelector('body[data-ready], body[data-error]', { timeout: 30000 });
+    const error = await tab.getAttribute('body', 'data-error');
+    check(error === null, `the page script ran without an exception${error ? ': ' + error : ''}`);
+    check(problems.length === 0, `no console error or warning, no request${problems.length ? ': ' + problems.join('; ') : ''}`);
+
+    const charts = await tab.$$eval('.chart', (boxes) => boxes.map((b) => ({
+      id: b.dataset.chart,
+      points: Number(b.dataset.points || 0),
+      canvas: !!b.querySelector('canvas'),
+    })));
+    const expected = ['trajectory-top', 'trajectory-side', 'ape', 'ase', 'ase-rotation', 'ase-position', 'ase-velocity',
+      'velocity', 'fit-degrees', 'fit-coefficients'];
+    check(JSON.stringify(charts.map((c) => c.id)) === JSON.stringify(expected), `the charts are ${expected.join(', ')} (got ${charts.map((c) => c.id).join(', ')})`);
+    for (const c of charts) check(c.points > 0 && c.canvas, `chart ${c.id} is drawn with data (${c.points} points)`);
+    const instances = await tab.evaluate(() => window.chevalReport.charts.map((c) => ({ id: c.id, series: c.plot.series.length, rows: c.plot.data.length })));
+    check(instances.length === expected.length && instances.every((c) => c.series >= 2), 'every chart is a uPlot instance with at least one series');
+
+    // The drawn canvases are not blank: the trajectory's canvas has pixels of the reference's ink.
+    const inked = await tab.$eval('#chart-trajectory-top canvas', (canvas) => {
+      const pixels = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
+      let n = 0;
+      for (let i = 0; i < pixels.length; i += 4) if (pixels[i + 3] > 0) n++;
+      return n;
+    });
+    check(inked > 1000, `the top view's canvas has ink (${inked} painted pixels)`);
+
+    // The table shows the embedded statistics (the numbers of `cheval ape --json`, checked by report_cli_test).
+    const table = await tab.evaluate(() => {
+      const data = window.chevalReport.data;
+      return data.estimates.map((e, i) => ({
+        shown: document.querySelector(`tr[data-estimate="${i}"] td[data-key="ape.rmse"]`).textContent,
+        embedded: e.ape.stats.rmse.toFixed(6),
+        aseShown: e.ase ? document.querySelector(`tr[data-estimate="${i}"] td[data-key="ase.rmse"]`).textContent : null,
+        aseEmbedded: e.ase ? e.ase.stats.rmse.toFixed(6) : null,
+      }));
+    });
+    check(table.length === 3 && table.every((r) => r.shown === r.embedded && r.aseShown === r.aseEmbedded), `the table shows the embedded APE and ASE RMSE (${JSON.stringify(table)})`);
+    const notes = await tab.$$eval('#notes li', (items) => items.map((i) => i.textContent));
+    check(notes.some((n) => n.includes('poses_only.tum has no velocity')), 'the page says the estimate without velocity has no ASE');
+    const aseNote = await tab.$eval('#chart-ase .chart-note', (n) => n.textContent);
+    check(aseNote.includes('poses_only.tum'), `the ASE chart names the estimate it leaves out (${aseNote})`);
+
+    // The velocity component buttons redraw the chart with data.
+    await tab.click('#velocity-controls button[data-component="vz"]');
+    const vz = await tab.$eval('#chart-velocity', (b) => Number(b.dataset.points));
+    check(vz > 0, `the velocity chart redrawn for vz has data (${vz} points)`);
+    await tab.click('#velocity-controls button[data-component="speed"]');
+
+    fs.mkdirSync(outputDir, { recursive: true });
+    const screenshot = path.join(outputDir, 'report.png');
+    await tab.screenshot({ path: screenshot, fullPage: true });
+    const size = fs.statSync(screenshot).size;
+    check(size > 50000, `screenshot ${screenshot} written (${size} bytes)`);
+    fs.copyFileSync(page, path.join(outputDir, 'report.html'));
+  } finally {
+    await context.close();
+  }
+}
+
+main()
+  .catch((e) => {
+    console.log(`FAILED: ${e.stack || e}`);
+    failures++;
+  })
+  .finally(() => {
+    fs.rmSync(work, { recursive: true, force: true });
+    fs.rmSync(profile, { recursive: true, force: true });
+    console.log(failures ? `browser_test: ${failures} check(s) failed` : 'browser_test: all checks passed');
+    process.exit(failures ? 1 : 0);
+  });
