@@ -2,7 +2,11 @@
 //   quadrotor_estimate [VEHICLE_JSON] [--seeds N] [--scaling]
 // 1. Every scenario x seeds 1..N (default 3): per-motor mean rotor-speed error (rpm, %), pose and
 //    velocity RMSE, states, iterations, seconds (one core).
-// 2. --scaling: hover-like flights of 10 s .. 300 s at the default segment length: seconds per state.
+// 2. --scaling: figure-eight flights of 10 s .. 300 s at the default segment length: seconds per state.
+// Options (defaults: QuadrotorEstimateOptions): --duration S, --degree N, --segment S, --order M and
+// --sigma-u σ (rotor smoothness prior), --sigma-p/-v/-w/-r σ (collocation), --trust-radius R,
+// --window S (initialisation), --only SCENARIO, --full-report (Ceres' report with stage times),
+// --dump PREFIX (writes PREFIX_<scenario>_<seed>.txt: t, estimated rotor 0..3, true rotor 0..3).
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -22,7 +26,7 @@ struct Row {
 };
 
 Row Run(const estim::Vehicle& vehicle, sim::QuadrotorScenario scenario, uint64_t seed, double duration,
-        const estim::QuadrotorEstimateOptions& options) {
+        const estim::QuadrotorEstimateOptions& options, const std::string& dump = "") {
   sim::QuadrotorSimOptions so;
   so.scenario = scenario;
   so.seed = seed;
@@ -33,6 +37,16 @@ Row Run(const estim::Vehicle& vehicle, sim::QuadrotorScenario scenario, uint64_t
   Row row;
   row.estimate = estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, options, times);
   row.errors = sim::CompareWithTruth(row.estimate, data.truth);
+  if (!dump.empty()) {  // t, estimated rotor 0..3, true rotor 0..3 (rad/s) at the truth times
+    std::FILE* f = std::fopen((dump + "_" + std::string(sim::ToString(scenario)) + "_" + std::to_string(seed) + ".txt").c_str(), "w");
+    for (size_t i = 0; i < row.estimate.samples.size() && i < data.truth.size(); ++i) {
+      const auto& e = row.estimate.samples[i];
+      const auto& g = data.truth[i];
+      std::fprintf(f, "%.3f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %.3f\n", e.t, e.rotor[0], e.rotor[1], e.rotor[2],
+                   e.rotor[3], g.rotor[0], g.rotor[1], g.rotor[2], g.rotor[3]);
+    }
+    std::fclose(f);
+  }
   return row;
 }
 
@@ -43,6 +57,8 @@ int main(int argc, char** argv) {
   int seeds = 3;
   bool scaling = false;
   double duration = 10.0;
+  std::string only, dump;
+  bool full_report = false;
   estim::QuadrotorEstimateOptions options;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--seeds") && i + 1 < argc) seeds = std::stoi(argv[++i]);
@@ -50,6 +66,17 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--duration") && i + 1 < argc) duration = std::stod(argv[++i]);
     else if (!std::strcmp(argv[i], "--degree") && i + 1 < argc) options.degree = std::stoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--segment") && i + 1 < argc) options.segment_s = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--order") && i + 1 < argc) options.rotor_prior_order = std::stoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--sigma-u") && i + 1 < argc) options.sigma_rotor_rate = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--sigma-v") && i + 1 < argc) options.sigma_acceleration = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--sigma-w") && i + 1 < argc) options.sigma_angular_acceleration = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--sigma-p") && i + 1 < argc) options.sigma_position_rate = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--sigma-r") && i + 1 < argc) options.sigma_rotation_rate = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--full-report")) full_report = true;
+    else if (!std::strcmp(argv[i], "--trust-radius") && i + 1 < argc) options.initial_trust_region_radius = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--window") && i + 1 < argc) options.initial_window_s = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
+    else if (!std::strcmp(argv[i], "--dump") && i + 1 < argc) dump = argv[++i];
     else vehicle_path = argv[i];
   }
   const estim::Vehicle vehicle = estim::ReadVehicle(vehicle_path);
@@ -58,8 +85,9 @@ int main(int argc, char** argv) {
                 "rotor error rpm (motor 0..3)", "rotor error % (motor 0..3)", "pos m", "rot deg", "vel m/s");
     double worst = 0;
     for (sim::QuadrotorScenario scenario : sim::AllQuadrotorScenarios()) {
+      if (!only.empty() && sim::ToString(scenario) != only) continue;
       for (int seed = 1; seed <= seeds; ++seed) {
-        const Row r = Run(vehicle, scenario, seed, duration, options);
+        const Row r = Run(vehicle, scenario, seed, duration, options, dump);
         const auto& e = r.errors;
         std::printf("%-11s %4d %6d %4d %7.3f | %7.2f %7.2f %7.2f %7.2f | %6.3f %6.3f %6.3f %6.3f | %8.4f %8.3f %8.4f%s\n",
                     std::string(sim::ToString(scenario)).c_str(), seed, r.estimate.states, r.estimate.iterations,
@@ -68,6 +96,7 @@ int main(int argc, char** argv) {
                     e.rotor_error_percent[3], e.position_rmse_m, e.rotation_rmse_deg, e.velocity_rmse_mps,
                     r.estimate.converged ? "" : "  (not converged)");
         worst = std::max(worst, e.rotor_error_percent.maxCoeff());
+        if (full_report) std::printf("%s\n", r.estimate.solver_full_report.c_str());
       }
     }
     std::printf("worst per-motor mean rotor-speed error: %.3f %%\n", worst);

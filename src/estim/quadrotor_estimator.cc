@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cmath>
 
+#include <Eigen/Dense>
+
 #include "cheval/common/error.h"
 #include "cheval/estim/problem.h"
 #include "cheval/lie/so3.h"
@@ -52,6 +54,60 @@ struct InitialTrajectory {
 
 }  // namespace
 
+QuadrotorStateEstimate FlatnessInitialState(const QuadrotorParameters& q, const std::vector<PoseSample>& poses,
+                                            double t, double window_s) {
+  if (poses.size() < 3) throw ComputeError("the flatness-based initialisation needs at least 3 poses");
+  if (!(window_s > 0)) throw UsageError(fmt::format("the initialisation window must be > 0 s, got {}", window_s));
+  const double first = poses.front().t, last = poses.back().t;
+  const double half = 0.5 * window_s;
+  const double center = last - first <= window_s ? 0.5 * (first + last) : std::clamp(t, first + half, last - half);
+  auto lo = std::lower_bound(poses.begin(), poses.end(), center - half - 1e-9,
+                             [](const PoseSample& s, double v) { return s.t < v; });
+  auto hi = std::upper_bound(poses.begin(), poses.end(), center + half + 1e-9,
+                             [](double v, const PoseSample& s) { return v < s.t; });
+  while (hi - lo < 3) {  // a window with too few poses: widen it by one pose on each side
+    if (lo != poses.begin()) --lo;
+    if (hi != poses.end()) ++hi;
+  }
+  const int n = static_cast<int>(hi - lo);
+  const Eigen::Quaterniond q_t = InitialTrajectory{poses}.At(t).q;
+  const lie::SO3d R_t(q_t);
+  Eigen::MatrixXd A(n, 3), P(n, 3), Phi(n, 3);
+  for (int i = 0; i < n; ++i) {
+    const PoseSample& s = *(lo + i);
+    const double tau = s.t - t;
+    A.row(i) << 1.0, tau, tau * tau;
+    P.row(i) = s.p.transpose();
+    Phi.row(i) = lie::SO3d(s.q).Minus(R_t).transpose();
+  }
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
+  const Eigen::MatrixXd c = qr.solve(P);                                     // p(t + τ) ≈ c0 + c1 τ + c2 τ²
+  const Eigen::MatrixXd b = A.leftCols(2).colPivHouseholderQr().solve(Phi);  // φ(t + τ) ≈ b0 + b1 τ
+  QuadrotorStateEstimate out;
+  out.t = t;
+  out.p = c.row(0).transpose();
+  out.v = c.row(1).transpose();
+  out.w = b.row(1).transpose();
+  out.R = q_t.toRotationMatrix();
+  const Eigen::Vector3d a = 2.0 * c.row(2).transpose();
+  const Eigen::Vector3d force =
+      q.mass_kg * (a + Eigen::Vector3d(0, 0, q.gravity_mps2)) + q.drag_coefficient * out.v.norm() * out.v;
+  const double thrust = force.dot(out.R.col(2));
+  const Eigen::Vector3d Jw = q.inertia_kgm2.cwiseProduct(out.w);
+  const Eigen::Vector3d tau = out.w.cross(Jw);
+  const double arm = q.arm_m, k = q.moment_coefficient / q.thrust_coefficient;
+  Eigen::Matrix4d mix;  // [T, τx, τy, τz] = mix · f (the motor layout of models.h)
+  mix << 1, 1, 1, 1,            //
+      arm, arm, -arm, -arm,     //
+      -arm, arm, arm, -arm,     //
+      -k, k, -k, k;
+  const Eigen::Vector4d f = mix.fullPivLu().solve(Eigen::Vector4d(thrust, tau.x(), tau.y(), tau.z()));
+  for (int i = 0; i < 4; ++i) {
+    out.rotor[i] = std::min(std::sqrt(std::max(f[i], 0.0) / q.thrust_coefficient), q.max_rotor_speed_radps);
+  }
+  return out;
+}
+
 QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Eigen::Vector3d>& landmarks,
                                     const std::vector<PixelObservation>& pixels,
                                     const std::vector<PoseSample>& initial, const QuadrotorEstimateOptions& options,
@@ -60,6 +116,9 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   if (options.degree < 2 || options.degree > 64) throw UsageError(fmt::format("--degree must be in [2, 64], got {}", options.degree));
   if (!(options.segment_s > 0) || !std::isfinite(options.segment_s)) {
     throw UsageError(fmt::format("--segment must be a positive number of seconds, got {}", options.segment_s));
+  }
+  if (!(options.initial_trust_region_radius > 0)) {
+    throw UsageError(fmt::format("the initial trust-region radius must be > 0, got {}", options.initial_trust_region_radius));
   }
   if (pixels.empty()) throw ComputeError("no camera measurements");
   double t0 = pixels.front().t, t1 = pixels.front().t;
@@ -84,22 +143,13 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   breakpoints.back() = t1;
   Problem problem(QuadrotorModel{vehicle.quadrotor}, breakpoints, options.degree);
 
-  // Initial values: the front end's poses; velocity and body rate from its differences over ±0.1 s;
-  // rotor speeds at hover.
-  const InitialTrajectory front_end{initial};
-  const double hover = vehicle.quadrotor.HoverRotorSpeed();
+  // Initial values: the flatness-based fit of the front end's poses (FlatnessInitialState).
   for (int g = 0; g < problem.num_nodes(); ++g) {
-    const double t = problem.NodeTime(g);
-    const PoseSample pose = front_end.At(t);
-    const double h = 0.1;
-    const PoseSample before = front_end.At(std::max(t - h, initial.front().t)),
-                     after = front_end.At(std::min(t + h, initial.back().t));
-    const double dt = std::max(after.t - before.t, 1e-9);
-    const Eigen::Vector3d v = (after.p - before.p) / dt;
-    const Eigen::Vector3d w = lie::SO3d(after.q).Minus(lie::SO3d(before.q)) / dt;
+    const QuadrotorStateEstimate x0 = FlatnessInitialState(vehicle.quadrotor, initial, problem.NodeTime(g),
+                                                           options.initial_window_s);
     Eigen::VectorXd x(9);
-    x << pose.p, v, w;
-    problem.SetNode(g, x, pose.q.toRotationMatrix(), Eigen::Vector4d::Constant(hover));
+    x << x0.p, x0.v, x0.w;
+    problem.SetNode(g, x, x0.R, x0.rotor);
   }
   problem.SetChartReferences();
 
@@ -107,7 +157,7 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   sigma << Eigen::Vector3d::Constant(options.sigma_position_rate), Eigen::Vector3d::Constant(options.sigma_acceleration),
       Eigen::Vector3d::Constant(options.sigma_angular_acceleration), Eigen::Vector3d::Constant(options.sigma_rotation_rate);
   problem.AddCollocation(sigma);
-  if (options.sigma_rotor_rate > 0) problem.AddControlRatePrior(options.sigma_rotor_rate);
+  if (options.sigma_rotor_rate > 0) problem.AddControlSmoothnessPrior(options.rotor_prior_order, options.sigma_rotor_rate);
 
   const PinholeCamera& cam = vehicle.camera;
   const double pixel_sigma = std::max(cam.pixel_noise_px, 0.1);  // a noise-free file still gets a finite weight
@@ -130,6 +180,7 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   solver.max_num_iterations = options.max_iterations;
   solver.num_threads = options.threads;
   solver.logging_type = ceres::SILENT;
+  solver.initial_trust_region_radius = options.initial_trust_region_radius;
   const ceres::Solver::Summary summary = problem.Solve(solver);
 
   QuadrotorEstimate out;
@@ -139,6 +190,7 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   out.iterations = static_cast<int>(summary.iterations.size()) - 1;
   out.converged = summary.termination_type == ceres::CONVERGENCE;
   out.solver_report = summary.BriefReport();
+  out.solver_full_report = summary.FullReport();
   out.start_time = t0;
   out.end_time = t1;
   for (double t : query_times) {

@@ -348,5 +348,76 @@ TEST(UnicycleModel, RecoversControlsFromPositions) {
   ExpectJacobianMatchesDifferences(problem);
 }
 
+// Gauss–Legendre with n points integrates every monomial of degree <= 2n − 1 exactly on [-1, 1]
+// (∫ x^k = 2/(k+1) for even k, 0 for odd): to rounding, 1e-14 on these O(1) sums.
+TEST(GaussLegendre, IsExactToDegreeTwoNMinusOne) {
+  for (int n = 1; n <= 12; ++n) {
+    Eigen::VectorXd x, w;
+    detail::GaussLegendre(n, &x, &w);
+    for (int k = 0; k <= 2 * n - 1; ++k) {
+      double sum = 0;
+      for (int q = 0; q < n; ++q) sum += w[q] * std::pow(x[q], k);
+      EXPECT_NEAR(sum, k % 2 == 0 ? 2.0 / (k + 1) : 0.0, 1e-14) << "n " << n << " k " << k;
+    }
+    // Degree 2n is not integrated exactly (the rule has exactly 2n − 1 degrees of exactness): the
+    // error there is still 1.8e-7 at n = 12, far above rounding.
+    double sum = 0;
+    for (int q = 0; q < n; ++q) sum += w[q] * std::pow(x[q], 2 * n);
+    EXPECT_GT(std::abs(sum - 2.0 / (2 * n + 1)), 1e-12) << n;
+  }
+}
+
+// A unicycle problem whose controls are the polynomials u0(t) = t³ − 2t, u1(t) = 0.5 t² + 1 on three
+// unequal segments of degree 5 (exactly representable), with only the smoothness prior in it.
+// With `kink`, u0 gets + 3 (t − 1.1) after the second breakpoint: u0' jumps by 3 there.
+PseudoSpectralProblem<UnicycleModel> PolynomialControls(int order, double sigma, bool kink = false) {
+  PseudoSpectralProblem<UnicycleModel> problem(UnicycleModel{}, {0.0, 0.4, 1.1, 2.0}, 5);
+  for (int g = 0; g < problem.num_nodes(); ++g) {
+    const double t = problem.NodeTime(g);
+    const double extra = kink && t > 1.1 ? 3.0 * (t - 1.1) : 0.0;
+    problem.SetNode(g, Eigen::Vector4d::Zero(), Eigen::Matrix3d::Identity(),
+                    Eigen::Vector2d(t * t * t - 2 * t + extra, 0.5 * t * t + 1));
+  }
+  problem.AddControlSmoothnessPrior(order, sigma);
+  return problem;
+}
+
+double TotalCost(ceres::Problem& cp) {
+  double cost = 0;
+  cp.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr);
+  return cost;
+}
+
+// The prior is ∫ |u^(m)|² dt / σ² exactly (Ceres' cost is half of it), against closed forms; the
+// quadrature is exact, so the match is to rounding (1e-12 relative).
+TEST(PseudoSpectralProblem, ControlSmoothnessPriorIsTheExactIntegral) {
+  const double sigma = 0.7;
+  // m = 1: ∫_0^2 (3t² − 2)² dt = [9t⁵/5 − 4t³ + 4t]_0^2 = 57.6 − 32 + 8 = 33.6, ∫_0^2 t² dt = 8/3.
+  // m = 2: ∫_0^2 (6t)² dt = 96, ∫_0^2 1 dt = 2 (u' is continuous: the jump residuals are 0).
+  // m = 3: ∫_0^2 6² dt = 72.
+  const double expected[4] = {0, 33.6 + 8.0 / 3.0, 96.0 + 2.0, 72.0};
+  for (int order : {1, 2, 3}) {
+    auto problem = PolynomialControls(order, sigma);
+    const double cost = TotalCost(problem.ceres_problem()), want = 0.5 * expected[order] / (sigma * sigma);
+    EXPECT_NEAR(cost, want, 1e-12 * want) << order;
+    ExpectJacobianMatchesDifferences(problem);
+  }
+  EXPECT_THROW(PolynomialControls(0, sigma), UsageError);
+  EXPECT_THROW(PolynomialControls(1, 0.0), UsageError);
+}
+
+// A kink (u0' jumps by 3 at t = 1.1; u'' unchanged) leaves the second-order integral unchanged but
+// the continuity residual holds u' continuous: the cost rises by ½ (3/σ₁)², σ₁ = σ h^(1/2) with h
+// the shortest node spacing of the two segments there (lengths 0.7 and 0.9 s).
+TEST(PseudoSpectralProblem, SecondOrderPriorPenalisesRateJumps) {
+  const double sigma = 2.0;
+  auto smooth = PolynomialControls(2, sigma), kinked = PolynomialControls(2, sigma, true);
+  const double c_smooth = TotalCost(smooth.ceres_problem()), c_kinked = TotalCost(kinked.ceres_problem());
+  const double x1 = std::cos(M_PI / 5);  // the Chebyshev point next to the end, degree 5
+  const double h = (1.0 - x1) * 0.7 / 2;
+  const double sigma_1 = sigma * std::sqrt(h);
+  EXPECT_NEAR(c_kinked - c_smooth, 0.5 * (3.0 / sigma_1) * (3.0 / sigma_1), 1e-9 * c_kinked);
+}
+
 }  // namespace
 }  // namespace cheval::estim

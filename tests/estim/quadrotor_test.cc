@@ -11,6 +11,7 @@
 #include "cheval/estim/models.h"
 #include "cheval/estim/quadrotor_estimator.h"
 #include "cheval/estim/vehicle.h"
+#include "cheval/lie/so3.h"
 #include "cheval/sim/quadrotor.h"
 
 namespace cheval {
@@ -136,7 +137,7 @@ TEST(QuadrotorSim, DataFolderRoundTripAndMissingFiles) {
 }
 
 // End to end on a short hover and a short figure-eight with the defaults: the rotor speeds come back
-// to well within 1 % (the 10 s runs of docs/estimator.md measure 0.3-0.7 %; 3 s flights have
+// to well within 1 % (the 10 s runs of docs/estimator.md measure 0.25-0.64 %; 3 s flights have
 // relatively more interval ends, so the bound here is 1 %), poses to a centimetre.
 TEST(QuadrotorEstimator, RecoversRotorSpeedsFromTheCamera) {
   const estim::Vehicle v = estim::ReadVehicle(kVehicle);
@@ -163,6 +164,49 @@ TEST(QuadrotorEstimator, RecoversRotorSpeedsFromTheCamera) {
     }
     EXPECT_GT(std::sqrt(initial_p2 / data.initial.size()), 3 * errors.position_rmse_m);
   }
+}
+
+// The flatness-based initialisation recovers a known flight from its exact poses: noise-free 10 Hz
+// poses of the simulated figure-eight (the truth at every third frame). A quadratic fit over ±h =
+// ±0.3 s biases v by p⁽³⁾ Στ⁴/(6 Στ²) = 0.0117 p⁽³⁾ on the 7 poses τ = 0, ±0.1, ±0.2, ±0.3 s
+// (p⁽³⁾ ≤ 5.8 m/s³ here: ≤ 0.068 m/s) and a by ~0.07 h² p⁽⁴⁾
+// (≤ 0.06 m/s², ~0.3 % of the rotor speed); the torques are taken as ω × Jω. So inside the flight
+// the rotor speeds come back within 0.6 %, v within 0.08 m/s and p within 3 mm (the cubic term
+// the fit cannot follow, ~h³ p⁽³⁾/20 ≈ 8 mm at most, mostly cancels at the window's centre, less
+// when t lies off it between poses); in the 0.3 s at each end the
+// window is one-sided (extrapolated fit): 1.5 %, 0.25 m/s and 1 cm. The hover start the estimator
+// used before is off by over 4 times as much.
+TEST(QuadrotorEstimator, FlatnessInitialStateRecoversAKnownFlight) {
+  const estim::Vehicle v = estim::ReadVehicle(kVehicle);
+  sim::QuadrotorSimOptions options;
+  options.scenario = sim::QuadrotorScenario::kFigureEight;
+  options.duration_s = 4.0;
+  const sim::QuadrotorData data = sim::SimulateQuadrotor(v, options);
+  std::vector<estim::PoseSample> poses;
+  for (const sim::PoseSample& frame : data.initial) {
+    const size_t i = static_cast<size_t>(std::lround(frame.t * 100));
+    if (std::abs(data.truth[i].t - frame.t) < 1e-9) poses.push_back({frame.t, data.truth[i].p, data.truth[i].q});
+  }
+  ASSERT_EQ(poses.size(), 41u);
+  double worst_rotor = 0, worst_hover = 0;
+  for (const sim::QuadrotorTruth& truth : data.truth) {
+    const estim::QuadrotorStateEstimate x0 = estim::FlatnessInitialState(v.quadrotor, poses, truth.t, 0.6);
+    const bool inside = truth.t >= 0.3 && truth.t <= 3.7;
+    for (int i = 0; i < 4; ++i) {
+      const double error = std::abs(x0.rotor[i] - truth.rotor[i]) / truth.rotor[i];
+      EXPECT_LT(error, inside ? 0.006 : 0.015) << truth.t;
+      worst_rotor = std::max(worst_rotor, error);
+      worst_hover = std::max(worst_hover, std::abs(v.quadrotor.HoverRotorSpeed() - truth.rotor[i]) / truth.rotor[i]);
+    }
+    EXPECT_LT((x0.v - truth.v).norm(), inside ? 0.08 : 0.25) << truth.t;
+    EXPECT_LT((x0.p - truth.p).norm(), inside ? 3e-3 : 1e-2) << truth.t;
+    // The rotation is the poses' own at a pose time (slerp between them otherwise).
+    if (std::abs(truth.t * 10 - std::round(truth.t * 10)) < 1e-9) {
+      EXPECT_LT(lie::SO3d(Eigen::Matrix3d(x0.R.transpose() * truth.q.toRotationMatrix())).Log().norm(), 1e-9);
+    }
+  }
+  EXPECT_GT(worst_hover, 4 * worst_rotor);
+  EXPECT_THROW(estim::FlatnessInitialState(v.quadrotor, {poses[0], poses[1]}, 0.0, 0.6), ComputeError);
 }
 
 TEST(QuadrotorEstimator, BadInputIsAnError) {
