@@ -6,6 +6,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "cheval/cheb/curve.h"
 #include "cheval/cheb/fit.h"
 
 namespace {
@@ -29,6 +30,30 @@ void BM_FitLeastSquares(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * m);
 }
 BENCHMARK(BM_FitLeastSquares)->Args({100'000, 400})->Args({20'000, 200})->Unit(benchmark::kMillisecond);
+
+// The whole adaptive curve fit (windows, cross-validation, end refinement) of m samples at 200 Hz
+// of a 3-D motion with 0.5 mm noise, with the velocity-risk end windows on (1) or off (0): what
+// `cheval velocity` spends between reading and writing, apart from the evaluation.
+void BM_FitCurve(benchmark::State& state) {
+  const auto m = static_cast<Eigen::Index>(state.range(0));
+  std::mt19937_64 rng(2);
+  std::normal_distribution<double> noise(0.0, 5e-4);
+  std::vector<int64_t> stamps(static_cast<size_t>(m));
+  Eigen::MatrixXd z(m, 3);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const double t = static_cast<double>(i) * 0.005;
+    stamps[static_cast<size_t>(i)] = static_cast<int64_t>(i) * 5'000'000;
+    z.row(i) << 2.0 * std::sin(0.31 * t) + 0.3 * std::sin(1.7 * t) + noise(rng),
+        1.5 * std::cos(0.23 * t) + 0.2 * std::sin(2.3 * t + 1.0) + noise(rng), 1.0 + 0.4 * std::sin(0.9 * t) + noise(rng);
+  }
+  CurveOptions options;
+  options.end_velocity_risk = state.range(1) != 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(FitCurve(stamps, z, options));
+  }
+  state.SetItemsProcessed(state.iterations() * m);
+}
+BENCHMARK(BM_FitCurve)->Args({100'000, 1})->Args({100'000, 0})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -216,6 +216,113 @@ class WindowFitter {
     }
   }
 
+  // The candidate degrees of a search up to `top`: 2, then a factor 1.25 apart (rounded, distinct),
+  // and top itself.
+  static std::vector<int> DegreeGrid(int top) {
+    std::vector<int> grid;
+    for (double g = 2; g < top; g *= 1.25) {
+      const int degree = static_cast<int>(std::lround(g));
+      if (grid.empty() || degree != grid.back()) grid.push_back(degree);
+    }
+    grid.push_back(top);
+    return grid;
+  }
+
+  // The estimated Σ over the core's samples of the velocity's mean squared error (per second²) of
+  // a fitted window; with `reduce`, each coordinate first gets the degree of least estimated error
+  // among its cross-validated degree R and the grid values below it (for a segment's end windows:
+  // cross-validation chooses degrees for the positions, while at an end the derivative's variance
+  // grows like N⁴/m, so the velocity there wants a lower degree).
+  //
+  // With v_N the fitted velocity of degree N at the core's samples (same samples and normal
+  // equations for every N <= R), the fits are nested projections: Cov(v_N, v_R) = Var(v_N), so
+  //   E Σ (v_N − v_R)² = Σ (b_N − b_R)² + Σ Var(v_R) − Σ Var(v_N)       (b the biases)
+  // and J(N) = Σ (v_N − v_R)² − Σ Var(v_R) + 2 Σ Var(v_N) is an unbiased estimate of Σ MSE(v_N)
+  // when b_R is negligible (Mallows' C_p for the derivative; J(R) = Σ Var(v_R)), with
+  // Var(v_N(t)) = σ²·d_N(t)ᵀG_N⁻¹d_N(t)·(2/L)², d_N(t) the row of T_k'(x), σ the noise estimate.
+  // Including −Σ Var(v_R) makes J comparable between windows covering the same samples.
+  double CoreVelocityRisk(CurveWindow* window, bool reduce) const {
+    const auto first = std::lower_bound(t_.data(), t_.data() + t_.size(), window->fit_begin) - t_.data();
+    const auto last = std::upper_bound(t_.data(), t_.data() + t_.size(), window->fit_end) - t_.data();
+    const auto core_first = std::lower_bound(t_.data(), t_.data() + t_.size(), window->core_begin) - t_.data();
+    const auto core_last = std::upper_bound(t_.data(), t_.data() + t_.size(), window->core_end) - t_.data();
+    const int top = *std::max_element(window->degrees.begin(), window->degrees.end());
+    if (core_last <= core_first) return 0.0;
+    const Interval& interval = window->series.interval;
+    const NormalEquations normal =
+        BuildNormalEquationsUnchecked(t_.segment(first, last - first), z_.middleRows(first, last - first), top, interval);
+    std::optional<NestedCholesky> cholesky;
+    try {
+      cholesky.emplace(normal, top);
+    } catch (const ComputeError&) {
+      return std::numeric_limits<double>::infinity();
+    }
+    // H = Σ_i d(t_i)d(t_i)ᵀ over the core's samples, d(t) = (T_k'(x))_k = (k·U_{k−1}(x))_k: then
+    // Σ_i (v_N − v_R)(t_i)² = (c_N − c_R)ᵀH(c_N − c_R) (c_N padded with zeros) and
+    // Σ_i d_iᵀG_N⁻¹d_i = Σ (G_N⁻¹ ∘ H_N), so no candidate is evaluated sample by sample.
+    Eigen::MatrixXd h = Eigen::MatrixXd::Zero(top + 1, top + 1);
+    {
+      Eigen::VectorXd d(top + 1);
+      for (Eigen::Index i = core_first; i < core_last; ++i) {
+        const double x = interval.ToUnit(t_[i]);
+        double u_prev = 0.0, u = 1.0;  // U_{-1}, U_0
+        d[0] = 0.0;
+        for (int k = 1; k <= top; ++k) {
+          d[k] = k * u;
+          const double next = 2.0 * x * u - u_prev;
+          u_prev = u;
+          u = next;
+        }
+        h.selfadjointView<Eigen::Lower>().rankUpdate(d);
+      }
+      h.triangularView<Eigen::StrictlyUpper>() = h.transpose();
+    }
+    const double scale = interval.DerivativeScale();
+    const std::vector<int> original = window->degrees;
+    bool changed = false;
+    double risk = 0.0;
+    for (size_t c = 0; c < window->degrees.size(); ++c) {
+      const int reference = window->degrees[c];
+      const auto col = static_cast<Eigen::Index>(c);
+      const Eigen::VectorXd c_reference = cholesky->Solve(reference, normal.rhs.col(col));
+      auto variance_sum = [&](int n) {
+        const Eigen::MatrixXd g_inverse = cholesky->Solve(n, Eigen::MatrixXd::Identity(n + 1, n + 1));
+        return sigma_[col] * sigma_[col] * g_inverse.cwiseProduct(h.topLeftCorner(n + 1, n + 1)).sum();
+      };
+      const double reference_variance = variance_sum(reference);
+      double best = reference_variance;
+      int best_degree = reference;
+      if (reduce && reference >= 3) {
+        for (int n : DegreeGrid(reference)) {
+          if (n >= reference) continue;
+          Eigen::VectorXd difference = -c_reference;
+          difference.head(n + 1) += cholesky->Solve(n, normal.rhs.col(col));
+          const auto hr = h.topLeftCorner(reference + 1, reference + 1);
+          const double j = difference.dot(hr * difference) - reference_variance + 2.0 * variance_sum(n);
+          if (j < best) best = j, best_degree = n;
+        }
+      }
+      risk += best * scale * scale;
+      if (best_degree != reference) {
+        window->degrees[c] = best_degree;
+        changed = true;
+      }
+    }
+    if (!changed) return risk;
+    const int degree = *std::max_element(window->degrees.begin(), window->degrees.end());
+    Eigen::MatrixXd coefficients = Eigen::MatrixXd::Zero(degree + 1, static_cast<Eigen::Index>(window->degrees.size()));
+    for (size_t c = 0; c < window->degrees.size(); ++c) {
+      const auto col = static_cast<Eigen::Index>(c);
+      const int n = window->degrees[c];
+      // Coordinates that keep their degree keep their coefficients.
+      coefficients.col(col).head(n + 1) = n == original[c] ? window->series.coefficients.col(col).head(n + 1)
+                                                           : cholesky->Solve(n, normal.rhs.col(col));
+    }
+    window->series.coefficients = std::move(coefficients);
+    Finish(window);
+    return risk;
+  }
+
   // Derivative coefficients of a fitted window.
   static void Finish(CurveWindow* window) {
     window->first_derivative = DerivativeCoefficients(window->series.coefficients);
@@ -302,12 +409,7 @@ class WindowFitter {
   // system is factorised once; each candidate degree is then two triangular solves of a leading
   // block.
   static std::vector<int> CrossValidatedDegrees(const Folds& folds, int top) {
-    std::vector<int> grid;
-    for (double g = 2; g < top; g *= 1.25) {
-      const int degree = static_cast<int>(std::lround(g));
-      if (grid.empty() || degree != grid.back()) grid.push_back(degree);
-    }
-    grid.push_back(top);
+    const std::vector<int> grid = DegreeGrid(top);
     const Eigen::Index d = folds.total.rhs.cols();
     Eigen::MatrixXd error = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(grid.size()), d);
     for (int fold = 0; fold < kFolds; ++fold) {
@@ -413,6 +515,37 @@ void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegme
       }
     }
   }
+  if (!options.end_velocity_risk) return;
+  // Then, by the velocity itself: the end window is halved while the estimated velocity error over
+  // its core (WindowFitter::CoreVelocityRisk) is lower for its two halves (the outer one at its
+  // degrees of least risk, the inner one as cross-validated) than for the window at its degrees of
+  // least risk; the final end windows keep those degrees.
+  for (const bool front : {true, false}) {
+    while (true) {
+      auto& windows = segment.windows;
+      const CurveWindow& end = front ? windows.front() : windows.back();
+      if (samples_in(end.core_begin, end.core_end) < 2 * options.min_window_samples) break;
+      const double a = end.core_begin, b = end.core_end, middle = 0.5 * (a + b);
+      CurveWindow whole = end;
+      const double risk_whole = fitter.CoreVelocityRisk(&whole, true);
+      CurveWindow outer = *fitter.Fit(front ? a : middle, front ? middle : b, segment.begin, segment.end, false);
+      CurveWindow inner = *fitter.Fit(front ? middle : a, front ? b : middle, segment.begin, segment.end, false);
+      CurveWindow outer_reduced = outer;
+      const double risk_split = fitter.CoreVelocityRisk(&outer_reduced, true) + fitter.CoreVelocityRisk(&inner, false);
+      if (!(risk_split < risk_whole)) break;
+      if (front) {
+        windows.erase(windows.begin());
+        windows.insert(windows.begin(), std::move(inner));
+        windows.insert(windows.begin(), std::move(outer));
+      } else {
+        windows.pop_back();
+        windows.push_back(std::move(inner));
+        windows.push_back(std::move(outer));
+      }
+    }
+  }
+  fitter.CoreVelocityRisk(&segment.windows.front(), true);
+  if (segment.windows.size() > 1) fitter.CoreVelocityRisk(&segment.windows.back(), true);
 }
 
 // Up to 4 coordinates, on the stack: evaluation allocates nothing.

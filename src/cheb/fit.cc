@@ -43,31 +43,26 @@ struct Moments {
 #define CHEVAL_MULTIVERSION
 #endif
 
-// Adds one chunk's contribution. Arrays have kChunk entries (padding has ω = 0); wz is d x kChunk.
-template <int D>
+// Adds one chunk's contribution. Arrays have kChunk entries; wz is d x kChunk. kWeighted = false
+// means every weight is 1 (w is not read and wz holds z): the same sums without the multiplies, so
+// the results are bit-identical to the weighted kernel with unit weights. Padding needs ω = 0, so
+// a partial chunk always goes through the weighted kernel.
+//
+// Two degrees per sweep: with A = T_n and B = T_{n+1} loaded once, the sums of degrees n and n + 1
+// are accumulated and T_{n+2}, T_{n+3} are written back in place, which halves the loads and
+// stores per sample and degree. Every sum still adds the same terms in the same order (lane l of
+// an accumulator takes the samples k ≡ l mod kLanes, in increasing k), so nothing changes but speed.
+template <int D, bool kWeighted>
 CHEVAL_MULTIVERSION void AccumulateChunk(const double* x, const double* w, const double* wz, int degree,
                                          Moments* moments) {
-  alignas(64) double t_prev[kChunk], t_cur[kChunk], two_x[kChunk];
+  alignas(64) double t_a[kChunk], t_b[kChunk], two_x[kChunk];
   for (int k = 0; k < kChunk; ++k) {
-    t_prev[k] = 1.0;
-    t_cur[k] = x[k];
+    t_a[k] = 1.0;
+    t_b[k] = x[k];
     two_x[k] = 2.0 * x[k];
   }
-  for (int n = 0; n <= degree; ++n) {
-    // Here t_prev = T_n and t_cur = T_{n+1}.
-    double acc_s[kLanes] = {}, acc_sq[kLanes] = {}, acc_prod[kLanes] = {}, acc_b[D][kLanes] = {};
-    for (int k = 0; k < kChunk; k += kLanes) {
-      for (int l = 0; l < kLanes; ++l) {
-        const double tn = t_prev[k + l], tn1 = t_cur[k + l], wk = w[k + l];
-        const double wtn = wk * tn;
-        acc_s[l] += wtn;
-        acc_sq[l] += wtn * tn;
-        acc_prod[l] += wtn * tn1;
-        for (int c = 0; c < D; ++c) acc_b[c][l] += wz[c * kChunk + k + l] * tn;
-        t_prev[k + l] = tn1;
-        t_cur[k + l] = two_x[k + l] * tn1 - tn;
-      }
-    }
+  auto store = [moments](int n, const double* acc_s, const double* acc_sq, const double* acc_prod,
+                         const double (*acc_b)[kLanes]) {
     double s = 0, sq = 0, prod = 0;
     for (int l = 0; l < kLanes; ++l) s += acc_s[l], sq += acc_sq[l], prod += acc_prod[l];
     moments->s[n] += s;
@@ -78,23 +73,72 @@ CHEVAL_MULTIVERSION void AccumulateChunk(const double* x, const double* w, const
       for (int l = 0; l < kLanes; ++l) bc += acc_b[c][l];
       moments->b(n, c) += bc;
     }
+  };
+  int n = 0;
+  for (; n + 1 <= degree; n += 2) {
+    // Here t_a = T_n and t_b = T_{n+1}.
+    double s0[kLanes] = {}, sq0[kLanes] = {}, prod0[kLanes] = {}, b0[D][kLanes] = {};
+    double s1[kLanes] = {}, sq1[kLanes] = {}, prod1[kLanes] = {}, b1[D][kLanes] = {};
+    for (int k = 0; k < kChunk; k += kLanes) {
+      for (int l = 0; l < kLanes; ++l) {
+        const double tn = t_a[k + l], tn1 = t_b[k + l];
+        const double tn2 = two_x[k + l] * tn1 - tn;
+        const double tn3 = two_x[k + l] * tn2 - tn1;
+        const double wtn = kWeighted ? w[k + l] * tn : tn;
+        const double wtn1 = kWeighted ? w[k + l] * tn1 : tn1;
+        s0[l] += wtn;
+        sq0[l] += wtn * tn;
+        prod0[l] += wtn * tn1;
+        s1[l] += wtn1;
+        sq1[l] += wtn1 * tn1;
+        prod1[l] += wtn1 * tn2;
+        for (int c = 0; c < D; ++c) {
+          b0[c][l] += wz[c * kChunk + k + l] * tn;
+          b1[c][l] += wz[c * kChunk + k + l] * tn1;
+        }
+        t_a[k + l] = tn2;
+        t_b[k + l] = tn3;
+      }
+    }
+    store(n, s0, sq0, prod0, b0);
+    store(n + 1, s1, sq1, prod1, b1);
+  }
+  if (n == degree) {
+    double s0[kLanes] = {}, sq0[kLanes] = {}, prod0[kLanes] = {}, b0[D][kLanes] = {};
+    for (int k = 0; k < kChunk; k += kLanes) {
+      for (int l = 0; l < kLanes; ++l) {
+        const double tn = t_a[k + l], tn1 = t_b[k + l];
+        const double wtn = kWeighted ? w[k + l] * tn : tn;
+        s0[l] += wtn;
+        sq0[l] += wtn * tn;
+        prod0[l] += wtn * tn1;
+        for (int c = 0; c < D; ++c) b0[c][l] += wz[c * kChunk + k + l] * tn;
+      }
+    }
+    store(n, s0, sq0, prod0, b0);
   }
 }
 
+// w == nullptr: unit weights.
 template <int D>
-void AccumulateAll(const Eigen::VectorXd& x, const Eigen::VectorXd& w, const Eigen::Ref<const Eigen::MatrixXd>& z,
-                   int degree, Moments* moments) {
+void AccumulateAll(const Eigen::VectorXd& x, const double* w, const Eigen::Ref<const Eigen::MatrixXd>& z, int degree,
+                   Moments* moments) {
   alignas(64) double cx[kChunk], cw[kChunk], cwz[D * kChunk];
   const Eigen::Index m = x.size();
   for (Eigen::Index begin = 0; begin < m; begin += kChunk) {
     const int count = static_cast<int>(std::min<Eigen::Index>(kChunk, m - begin));
     for (int k = 0; k < kChunk; ++k) {
       const bool live = k < count;
+      const double wk = live ? (w != nullptr ? w[begin + k] : 1.0) : 0.0;
       cx[k] = live ? x[begin + k] : 0.0;
-      cw[k] = live ? w[begin + k] : 0.0;
-      for (int c = 0; c < D; ++c) cwz[c * kChunk + k] = live ? w[begin + k] * z(begin + k, c) : 0.0;
+      cw[k] = wk;
+      for (int c = 0; c < D; ++c) cwz[c * kChunk + k] = live ? wk * z(begin + k, c) : 0.0;
     }
-    AccumulateChunk<D>(cx, cw, cwz, degree, moments);
+    if (w == nullptr && count == kChunk) {
+      AccumulateChunk<D, false>(cx, cw, cwz, degree, moments);
+    } else {
+      AccumulateChunk<D, true>(cx, cw, cwz, degree, moments);
+    }
   }
 }
 
@@ -122,7 +166,7 @@ NormalEquations BuildNormalEquationsUnchecked(const Eigen::Ref<const Eigen::Vect
   const int d = static_cast<int>(z.cols());
   Eigen::VectorXd x(m);
   for (Eigen::Index i = 0; i < m; ++i) x[i] = interval.ToUnit(t[i]);
-  const Eigen::VectorXd w = weights != nullptr ? *weights : Eigen::VectorXd::Ones(m);
+  const double* w = weights != nullptr ? weights->data() : nullptr;
   Moments moments;
   moments.s.assign(2 * top + 2, 0.0);
   moments.squares.assign(top + 1, 0.0);
@@ -146,8 +190,8 @@ NormalEquations BuildNormalEquationsUnchecked(const Eigen::Ref<const Eigen::Vect
   normal.samples = m;
   normal.rhs = std::move(moments.b);
   normal.gram.resize(top + 1, top + 1);
-  for (int i = 0; i <= top; ++i) {
-    for (int j = 0; j <= top; ++j) normal.gram(i, j) = 0.5 * (s[i + j] + s[std::abs(i - j)]);
+  for (int j = 0; j <= top; ++j) {  // column by column: the matrix is column-major
+    for (int i = 0; i <= top; ++i) normal.gram(i, j) = 0.5 * (s[i + j] + s[std::abs(i - j)]);
   }
   return normal;
 }
@@ -218,20 +262,22 @@ ChebyshevSeries FitLeastSquares(const Eigen::Ref<const Eigen::VectorXd>& t, cons
 }
 
 CHEVAL_MULTIVERSION Eigen::MatrixXd EvaluateSeries(const Eigen::Ref<const Eigen::MatrixXd>& coefficients,
-                               const Eigen::Ref<const Eigen::VectorXd>& x) {
+                                                   const Eigen::Ref<const Eigen::VectorXd>& x) {
   const Eigen::Index n = coefficients.rows() - 1, m = x.size(), d = coefficients.cols();
   Eigen::MatrixXd result(m, d);
-  // kLanes points at a time: independent Clenshaw chains the compiler vectorises (one chain alone
-  // is bound by the latency of its multiply-add).
+  // kPoints points at a time: independent Clenshaw chains the compiler vectorises. One chain (or
+  // one vector of kLanes chains) is bound by the latency of its multiply-add; 4 vectors of them
+  // keep both FMA ports busy. Each point's recurrence is the same arithmetic in any case.
+  constexpr int kPoints = 4 * kLanes;
   for (Eigen::Index c = 0; c < d; ++c) {
     const double* a = coefficients.col(c).data();
-    for (Eigen::Index begin = 0; begin < m; begin += kLanes) {
-      const int count = static_cast<int>(std::min<Eigen::Index>(kLanes, m - begin));
-      double xs[kLanes], b1[kLanes] = {}, b2[kLanes] = {};
-      for (int l = 0; l < kLanes; ++l) xs[l] = l < count ? x[begin + l] : 0.0;
+    for (Eigen::Index begin = 0; begin < m; begin += kPoints) {
+      const int count = static_cast<int>(std::min<Eigen::Index>(kPoints, m - begin));
+      alignas(64) double xs[kPoints], b1[kPoints] = {}, b2[kPoints] = {};
+      for (int l = 0; l < kPoints; ++l) xs[l] = l < count ? x[begin + l] : 0.0;
       for (Eigen::Index k = n; k >= 1; --k) {
         const double ak = a[k];
-        for (int l = 0; l < kLanes; ++l) {
+        for (int l = 0; l < kPoints; ++l) {
           const double b0 = 2.0 * xs[l] * b1[l] - b2[l] + ak;
           b2[l] = b1[l];
           b1[l] = b0;

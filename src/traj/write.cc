@@ -24,7 +24,7 @@ Eigen::Vector4d QuaternionAsStored(const TrajectoryView& trajectory, Eigen::Inde
 }
 
 // FormatSeconds(stamp_ns) appended to `out` without a temporary string (the writers' hot loop).
-void AppendSeconds(fmt::memory_buffer& out, int64_t stamp_ns) {
+void AppendSeconds(std::string& out, int64_t stamp_ns) {
   const bool negative = stamp_ns < 0;
   const uint64_t magnitude = negative ? (~static_cast<uint64_t>(stamp_ns) + 1) : static_cast<uint64_t>(stamp_ns);
   fmt::format_to(std::back_inserter(out), FMT_COMPILE("{}{}.{:09}"), negative ? "-" : "", magnitude / 1'000'000'000ULL,
@@ -41,7 +41,12 @@ void RequireOrientation(const TrajectoryView& trajectory, Format format) {
 }  // namespace
 
 std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
-  fmt::memory_buffer out;
+  // Formatted straight into the string that is returned (no copy of the whole text at the end),
+  // reserved once for the longest possible lines (a shortest round-trip double has at most 24
+  // characters, a stamp at most 21) so that it is never regrown: each regrowth copies the text.
+  std::string out;
+  const size_t values_per_line = 1 + 12 + (trajectory.has_velocity() ? 3 : 0) + (trajectory.has_angular_velocity() ? 3 : 0);
+  out.reserve(static_cast<size_t>(trajectory.size()) * values_per_line * 25 + 256);
   auto it = std::back_inserter(out);
   const auto p = trajectory.positions();
   switch (format) {
@@ -100,7 +105,7 @@ std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
     default:
       throw UsageError(fmt::format("cannot write format '{}'; expected tum, tumv, euroc or kitti", ToString(format)));
   }
-  return fmt::to_string(out);
+  return out;
 }
 
 void WriteFileAtomically(const std::string& path, std::string_view text) {

@@ -1,5 +1,6 @@
 #include "cheval/cheb/fit.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -94,6 +95,60 @@ TEST(FitLeastSquares, TooFewSamplesIsAComputeError) {
   // Enough samples but all at the same stamp: singular.
   Eigen::VectorXd same = Eigen::VectorXd::Constant(50, 0.5);
   EXPECT_THROW(FitLeastSquares(same, Eigen::MatrixXd::Zero(50, 1), 3, Interval{0.0, 1.0}), ComputeError);
+}
+
+// The moment accumulation has an unweighted kernel (no ω read, no multiplies) and sweeps two
+// degrees at a time; both must give exactly the sums of the weighted kernel with unit weights
+// (same terms, same order), for odd and even top degrees, partial chunks and 1..4 coordinates.
+TEST(BuildNormalEquations, UnweightedKernelIsBitIdenticalToUnitWeights) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> normal;
+  for (const int m : {37, 512, 1500}) {
+    for (const int top : {0, 1, 6, 7, 30}) {
+      for (const int d : {1, 3, 4}) {
+        if (m < top + 1) continue;
+        const Interval interval{0.0, 3.0};
+        const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(m, 0.0, 3.0);
+        Eigen::MatrixXd z(m, d);
+        for (int i = 0; i < m; ++i) {
+          for (int c = 0; c < d; ++c) z(i, c) = std::sin((c + 1) * t[i]) + 0.01 * normal(rng);
+        }
+        const Eigen::VectorXd ones = Eigen::VectorXd::Ones(m);
+        const NormalEquations unweighted = BuildNormalEquations(t, z, top, interval);
+        const NormalEquations weighted = BuildNormalEquations(t, z, top, interval, &ones);
+        EXPECT_EQ(unweighted.gram, weighted.gram) << m << " " << top << " " << d;
+        EXPECT_EQ(unweighted.rhs, weighted.rhs) << m << " " << top << " " << d;
+        // And both are the sums they stand for: G_ij = Σ T_i T_j, b_k = Σ T_k z (to rounding).
+        Eigen::MatrixXd basis(m, top + 1);
+        for (int i = 0; i < m; ++i) {
+          const double x = interval.ToUnit(t[i]);
+          for (int k = 0; k <= top; ++k) basis(i, k) = std::cos(k * std::acos(std::clamp(x, -1.0, 1.0)));
+        }
+        EXPECT_LE((unweighted.gram - basis.transpose() * basis).cwiseAbs().maxCoeff(), 1e-10 * m);
+        EXPECT_LE((unweighted.rhs - basis.transpose() * z).cwiseAbs().maxCoeff(), 1e-10 * m);
+      }
+    }
+  }
+}
+
+// The batch Clenshaw runs 32 independent chains at a time; each point's value must be exactly the
+// one-point recurrence (Clenshaw) to rounding, including the partial last block.
+TEST(EvaluateSeries, MatchesPointwiseClenshaw) {
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (const int n : {0, 1, 5, 120}) {
+    const Eigen::MatrixXd coefficients = Eigen::MatrixXd::Random(n + 1, 3);
+    for (const int m : {1, 31, 32, 33, 100}) {
+      Eigen::VectorXd x(m);
+      for (int i = 0; i < m; ++i) x[i] = uniform(rng);
+      const Eigen::MatrixXd values = EvaluateSeries(coefficients, x);
+      ASSERT_EQ(values.rows(), m);
+      for (int i = 0; i < m; ++i) {
+        const Eigen::RowVectorXd one = Clenshaw(coefficients, x[i]);
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(values(i, c), one[c], 1e-14 * (1.0 + coefficients.cwiseAbs().sum()));
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -60,6 +60,15 @@ struct CurveOptions {
   /// best geometric-mean full-range error over the synthetic kinds of bench/velocity_accuracy
   /// among 0, 10 and 20 (docs/velocity.md).
   int end_degree = 20;
+  /// After that, choose the end windows by their velocity: an end window is halved while the
+  /// estimated velocity mean squared error over its core (Mallows' C_p for the derivative against
+  /// the cross-validated fit, from the known noise of a least-squares fit) is lower for the halves,
+  /// and each coordinate of the final end windows keeps the degree of least estimated velocity
+  /// error (at most the cross-validated one). Cross-validation measures position error, which does
+  /// not see the N⁴/m growth of the derivative's variance at an end. Needs end_degree > 0. Off by
+  /// default: over 15 simulator seeds it helped the legged kind (more seeds within Savitzky–Golay's
+  /// error) but made other rows worse by up to ~25 % (docs/velocity.md, "Ends by velocity risk").
+  bool end_velocity_risk = false;
   /// Fit a single window over each gap-free segment (no splitting), e.g. to reproduce a global fit.
   bool single_window = false;
 };
