@@ -4,9 +4,11 @@
 //    velocity RMSE, states, iterations, seconds (one core).
 // 2. --scaling: figure-eight flights of 10 s .. 300 s at the default segment length: seconds per state.
 // Options (defaults: QuadrotorEstimateOptions): --duration S, --degree N, --segment S, --order M and
-// --sigma-u σ (rotor smoothness prior), --sigma-p/-v/-w/-r σ (collocation), --trust-radius R,
-// --window S (initialisation), --only SCENARIO, --full-report (Ceres' report with stage times),
-// --dump PREFIX (writes PREFIX_<scenario>_<seed>.txt: t, estimated rotor 0..3, true rotor 0..3).
+// --sigma-u σ (rotor smoothness prior; the pilot's with the adaptive prior), --fixed-prior (σ_u
+// everywhere, no empirical Bayes), --floor σ and --pilot-iterations K (adaptive prior),
+// --sigma-p/-v/-w/-r σ (collocation), --trust-radius R, --window S (initialisation), --only SCENARIO,
+// --full-report (Ceres' report of the final solve, with stage times), --dump PREFIX (writes
+// PREFIX_<scenario>_<seed>.txt: t, estimated rotor 0..3, true rotor 0..3).
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -72,6 +74,9 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--sigma-w") && i + 1 < argc) options.sigma_angular_acceleration = std::stod(argv[++i]);
     else if (!std::strcmp(argv[i], "--sigma-p") && i + 1 < argc) options.sigma_position_rate = std::stod(argv[++i]);
     else if (!std::strcmp(argv[i], "--sigma-r") && i + 1 < argc) options.sigma_rotation_rate = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--fixed-prior")) options.adaptive_rotor_prior = false;
+    else if (!std::strcmp(argv[i], "--floor") && i + 1 < argc) options.adaptive_rotor_prior_floor = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--pilot-iterations") && i + 1 < argc) options.pilot_iterations = std::stoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--full-report")) full_report = true;
     else if (!std::strcmp(argv[i], "--trust-radius") && i + 1 < argc) options.initial_trust_region_radius = std::stod(argv[++i]);
     else if (!std::strcmp(argv[i], "--window") && i + 1 < argc) options.initial_window_s = std::stod(argv[++i]);

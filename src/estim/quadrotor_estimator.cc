@@ -108,6 +108,22 @@ QuadrotorStateEstimate FlatnessInitialState(const QuadrotorParameters& q, const 
   return out;
 }
 
+std::vector<double> AdaptiveRotorPriorSigma(const std::vector<double>& energy, int degree, int controls) {
+  if (degree < 1 || controls < 1) throw UsageError("the adaptive rotor prior needs degree >= 1 and controls >= 1");
+  const int S = static_cast<int>(energy.size());
+  std::vector<double> sigma(S);
+  for (int s = 0; s < S; ++s) {
+    double sum = 0;
+    int pooled = 0;
+    for (int n = std::max(s - 1, 0); n <= std::min(s + 1, S - 1); ++n, ++pooled) {
+      if (!(energy[n] >= 0)) throw UsageError(fmt::format("segment {} has a negative rotor-rate energy", n));
+      sum += energy[n];
+    }
+    sigma[s] = std::sqrt(sum / (static_cast<double>(pooled) * degree * controls));
+  }
+  return sigma;
+}
+
 QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Eigen::Vector3d>& landmarks,
                                     const std::vector<PixelObservation>& pixels,
                                     const std::vector<PoseSample>& initial, const QuadrotorEstimateOptions& options,
@@ -116,6 +132,12 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   if (options.degree < 2 || options.degree > 64) throw UsageError(fmt::format("--degree must be in [2, 64], got {}", options.degree));
   if (!(options.segment_s > 0) || !std::isfinite(options.segment_s)) {
     throw UsageError(fmt::format("--segment must be a positive number of seconds, got {}", options.segment_s));
+  }
+  if (options.pilot_iterations < 1) {
+    throw UsageError(fmt::format("the pilot solve needs >= 1 iteration, got {}", options.pilot_iterations));
+  }
+  if (!(options.adaptive_rotor_prior_floor > 0)) {
+    throw UsageError(fmt::format("the adaptive rotor-prior floor must be > 0, got {}", options.adaptive_rotor_prior_floor));
   }
   if (!(options.initial_trust_region_radius > 0)) {
     throw UsageError(fmt::format("the initial trust-region radius must be > 0, got {}", options.initial_trust_region_radius));
@@ -181,13 +203,27 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   solver.num_threads = options.threads;
   solver.logging_type = ceres::SILENT;
   solver.initial_trust_region_radius = options.initial_trust_region_radius;
-  const ceres::Solver::Summary summary = problem.Solve(solver);
+  const bool adaptive = options.adaptive_rotor_prior && options.sigma_rotor_rate > 0 && options.rotor_prior_order == 1;
+  if (adaptive) solver.max_num_iterations = options.pilot_iterations;
+  ceres::Solver::Summary summary = problem.Solve(solver);
+  int iterations = static_cast<int>(summary.iterations.size()) - 1;
+  if (adaptive) {  // empirical Bayes: σ per segment from the pilot's rotor speeds, then the solve
+    std::vector<double> energy(problem.num_segments());
+    for (int s = 0; s < problem.num_segments(); ++s) energy[s] = problem.ControlDerivativeEnergy(1, s);
+    const std::vector<double> segment_sigma = AdaptiveRotorPriorSigma(energy, options.degree, QuadrotorModel::kControlDim);
+    for (int s = 0; s < problem.num_segments(); ++s) {
+      problem.SetControlSmoothnessSigma(s, std::max(options.adaptive_rotor_prior_floor, segment_sigma[s]));
+    }
+    solver.max_num_iterations = options.max_iterations;
+    summary = problem.Solve(solver);
+    iterations += static_cast<int>(summary.iterations.size()) - 1;
+  }
 
   QuadrotorEstimate out;
   out.states = problem.num_nodes();
   out.segments = problem.num_segments();
   out.degree = problem.degree();
-  out.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  out.iterations = iterations;
   out.converged = summary.termination_type == ceres::CONVERGENCE;
   out.solver_report = summary.BriefReport();
   out.solver_full_report = summary.FullReport();

@@ -1,6 +1,7 @@
 // The quadrotor: model (torques of the motor layout, hover), vehicle files (good and bad), the
 // simulator (physics consistency with the model, camera, determinism) and the estimator end to end.
 #include <cmath>
+#include <random>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -136,18 +137,29 @@ TEST(QuadrotorSim, DataFolderRoundTripAndMissingFiles) {
   fs::remove_all(dir);
 }
 
+// A simulated 4 s flight (seed 1) and the truth's times, where the estimate is reported.
+struct Flight {
+  sim::QuadrotorData data;
+  std::vector<double> times;
+};
+Flight FourSecondFlight(const estim::Vehicle& v, sim::QuadrotorScenario scenario) {
+  sim::QuadrotorSimOptions options;
+  options.scenario = scenario;
+  options.duration_s = 4.0;
+  Flight flight{sim::SimulateQuadrotor(v, options), {}};
+  for (const auto& t : flight.data.truth) flight.times.push_back(t.t);
+  return flight;
+}
+
 // End to end on a short hover and a short figure-eight with the defaults: the rotor speeds come back
-// to well within 1 % (the 10 s runs of docs/estimator.md measure 0.25-0.64 %; 3 s flights have
+// to well within 1 % (the 10 s runs of docs/estimator.md measure 0.03-0.56 %; 4 s flights have
 // relatively more interval ends, so the bound here is 1 %), poses to a centimetre.
 TEST(QuadrotorEstimator, RecoversRotorSpeedsFromTheCamera) {
   const estim::Vehicle v = estim::ReadVehicle(kVehicle);
   for (sim::QuadrotorScenario scenario : {sim::QuadrotorScenario::kHover, sim::QuadrotorScenario::kFigureEight}) {
-    sim::QuadrotorSimOptions options;
-    options.scenario = scenario;
-    options.duration_s = 4.0;
-    const sim::QuadrotorData data = sim::SimulateQuadrotor(v, options);
-    std::vector<double> times;
-    for (const auto& t : data.truth) times.push_back(t.t);
+    const Flight flight = FourSecondFlight(v, scenario);
+    const sim::QuadrotorData& data = flight.data;
+    const std::vector<double>& times = flight.times;
     const estim::QuadrotorEstimate e =
         estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, {}, times);
     EXPECT_TRUE(e.converged) << e.solver_report;
@@ -207,6 +219,76 @@ TEST(QuadrotorEstimator, FlatnessInitialStateRecoversAKnownFlight) {
   }
   EXPECT_GT(worst_hover, 4 * worst_rotor);
   EXPECT_THROW(estim::FlatnessInitialState(v.quadrotor, {poses[0], poses[1]}, 0.0, 0.6), ComputeError);
+}
+
+// AdaptiveRotorPriorSigma is the maximum-likelihood random-walk intensity: pooled closed form on
+// three segments, and on a seeded random walk of known σ = 40 (u' white noise, increments
+// N(0, σ² Δt), 10 steps per segment, 4 controls, 300 segments). An inner segment pools 120 squared
+// increments: σ̂/σ = sqrt(χ²₁₂₀/120), relative spread 1/√240 = 6.5 %, so 25 % bounds every
+// segment (3.9 spreads); the mean over 300 segments spreads 0.37 %: 2 % is 5 of those.
+TEST(QuadrotorEstimator, AdaptiveRotorPriorSigmaIsTheRandomWalkMaximumLikelihood) {
+  const std::vector<double> three = estim::AdaptiveRotorPriorSigma({4.0, 16.0, 100.0}, 10, 4);
+  ASSERT_EQ(three.size(), 3u);
+  EXPECT_NEAR(three[0], std::sqrt(20.0 / (2 * 40)), 1e-12);
+  EXPECT_NEAR(three[1], std::sqrt(120.0 / (3 * 40)), 1e-12);
+  EXPECT_NEAR(three[2], std::sqrt(116.0 / (2 * 40)), 1e-12);
+  EXPECT_NEAR(estim::AdaptiveRotorPriorSigma({9.0}, 1, 1)[0], 3.0, 1e-12);
+  EXPECT_THROW(estim::AdaptiveRotorPriorSigma({1.0, -1.0}, 10, 4), UsageError);
+  EXPECT_THROW(estim::AdaptiveRotorPriorSigma({1.0}, 0, 4), UsageError);
+
+  const double sigma = 40, dt = 0.1;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> normal(0.0, sigma * std::sqrt(dt));
+  std::vector<double> energy(300, 0.0);
+  for (double& e : energy) {
+    for (int k = 0; k < 10 * 4; ++k) {
+      const double step = normal(rng);
+      e += step * step / dt;  // Σ (Δu)²/Δt: ∫ |u'|² of the piecewise-linear path
+    }
+  }
+  const std::vector<double> estimate = estim::AdaptiveRotorPriorSigma(energy, 10, 4);
+  double mean = 0;
+  for (double e : estimate) {
+    EXPECT_NEAR(e, sigma, 0.25 * sigma);
+    mean += e / estimate.size();
+  }
+  EXPECT_NEAR(mean, sigma, 0.02 * sigma);
+}
+
+// End to end: the adaptive prior (the default) against one σ_u = 100 everywhere on a 4 s hover and
+// a 4 s aggressive flight (seed 1). Hover: the truth's rotor speeds are constant, the pilot's rotor
+// rate is noise, so σ drops to the floor: 0.120 % against 0.429 % (bound: half); aggressive: 0.835 %
+// against 0.950 % (bound: better; 4 s has relatively more flight ends than the 10 s runs of
+// docs/estimator.md). The same iteration budget: one pilot iteration plus the final solve, 3 in all.
+TEST(QuadrotorEstimator, AdaptiveRotorPriorBeatsOneFixedSigma) {
+  const estim::Vehicle v = estim::ReadVehicle(kVehicle);
+  for (sim::QuadrotorScenario scenario : {sim::QuadrotorScenario::kHover, sim::QuadrotorScenario::kAggressive}) {
+    const Flight flight = FourSecondFlight(v, scenario);
+    const sim::QuadrotorData& data = flight.data;
+    const std::vector<double>& times = flight.times;
+    estim::QuadrotorEstimateOptions fixed;
+    fixed.adaptive_rotor_prior = false;
+    const estim::QuadrotorEstimate a = estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, {}, times);
+    const estim::QuadrotorEstimate f = estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, fixed, times);
+    EXPECT_TRUE(a.converged) << a.solver_report;
+    const double adaptive_error = sim::CompareWithTruth(a, data.truth).rotor_error_percent.maxCoeff();
+    const double fixed_error = sim::CompareWithTruth(f, data.truth).rotor_error_percent.maxCoeff();
+    if (scenario == sim::QuadrotorScenario::kHover) {
+      EXPECT_LT(adaptive_error, 0.5 * fixed_error);
+    } else {
+      EXPECT_LT(adaptive_error, fixed_error);
+    }
+    EXPECT_LE(a.iterations, f.iterations + 1);
+  }
+  estim::QuadrotorEstimateOptions bad;
+  bad.pilot_iterations = 0;
+  sim::QuadrotorSimOptions options;
+  options.duration_s = 1.0;
+  const sim::QuadrotorData data = sim::SimulateQuadrotor(v, options);
+  EXPECT_THROW(estim::EstimateQuadrotor(v, data.landmarks, data.pixels, data.initial, bad, {}), UsageError);
+  bad = {};
+  bad.adaptive_rotor_prior_floor = 0;
+  EXPECT_THROW(estim::EstimateQuadrotor(v, data.landmarks, data.pixels, data.initial, bad, {}), UsageError);
 }
 
 TEST(QuadrotorEstimator, BadInputIsAnError) {

@@ -26,7 +26,9 @@
 /// - AddDerivativeMeasurement: h(x'(t)) of the vector part's derivative (derivative row).
 /// - AddVectorPrior / AddRotationPrior / AddControlPrior at a node.
 /// - AddControlSmoothnessPrior: ∫ |u^(m)|² dt / σ², exact per segment (Gauss–Legendre), with the
-///   jumps of the lower derivatives held at the breakpoints for m >= 2; AddControlRatePrior: the
+///   jumps of the lower derivatives held at the breakpoints for m >= 2; SetControlSmoothnessSigma
+///   re-weights one segment's integral (a σ that varies along the span), ControlDerivativeEnergy
+///   returns ∫_s |u^(m)|² dt of the current controls; AddControlRatePrior: the
 ///   older equal-weight sum of (D U)_j² at the nodes (not a quadrature: kept for existing callers).
 
 #include <fmt/format.h>
@@ -276,24 +278,14 @@ class PseudoSpectralProblem {
     }
     if (!(sigma > 0)) throw UsageError("the control smoothness sigma must be > 0");
     const int N = degree_;
-    Eigen::MatrixXd Dm = Eigen::MatrixXd::Identity(N + 1, N + 1);
-    for (int i = 0; i < order; ++i) Dm = D_ * Dm;
-    const int nq = N - order + 1;
-    Eigen::VectorXd xq, wq;
-    detail::GaussLegendre(nq, &xq, &wq);
-    Eigen::RowVectorXd row(N + 1);
+    smoothness_costs_.clear();
     for (int s = 0; s < num_segments(); ++s) {
-      const double length = breakpoints_[s + 1] - breakpoints_[s];
-      const double scale = std::pow(Interval(s).DerivativeScale(), order);
-      Eigen::MatrixXd coefficients(nq, N + 1);
-      for (int q = 0; q < nq; ++q) {
-        basis_.InterpolationRow(xq[q], row);
-        coefficients.row(q) = std::sqrt(wq[q] * length / 2) * scale / sigma * (row * Dm);
-      }
       std::vector<int> nodes;
       for (int k = 0; k <= N; ++k) nodes.push_back(NodeOf(s, k));
-      auto* cost = new LinearControlCost(this, nodes, coefficients);
+      auto* cost = new LinearControlCost(this, nodes, SmoothnessRows(order, s));
+      cost->set_weight(1.0 / sigma);
       problem_->AddResidualBlock(cost, nullptr, cost->blocks());
+      smoothness_costs_.push_back(cost);
     }
     // Continuity of u', ..., u^(m-1) at the inner breakpoints.
     const double h_unit = 1.0 - basis_.points()[1];  // shortest node spacing in x (at the ends)
@@ -318,6 +310,28 @@ class PseudoSpectralProblem {
         problem_->AddResidualBlock(cost, nullptr, cost->blocks());
       }
     }
+  }
+
+  /// Replaces σ of segment s's integral ∫_s |u^(m)|² dt / σ² of AddControlSmoothnessPrior (which must
+  /// have been called; the jump residuals of m >= 2 keep the σ given there): a prior whose intensity
+  /// varies along the span (heteroscedastic). Takes effect at the next Solve. Throws UsageError for
+  /// sigma <= 0, a segment out of range or no smoothness prior.
+  void SetControlSmoothnessSigma(int s, double sigma) {
+    if (smoothness_costs_.empty()) throw UsageError("no control smoothness prior to re-weight");
+    if (s < 0 || s >= num_segments()) throw UsageError(fmt::format("segment {} out of range [0, {})", s, num_segments()));
+    if (!(sigma > 0)) throw UsageError("the control smoothness sigma must be > 0");
+    smoothness_costs_[s]->set_weight(1.0 / sigma);
+  }
+
+  /// ∫ |u^(m)(t)|² dt over segment s of the current controls, summed over the control entries
+  /// (exact: Gauss–Legendre with N − m + 1 points). order in [1, N]; UsageError otherwise.
+  double ControlDerivativeEnergy(int order, int s) const {
+    if (order < 1 || order > degree_) throw UsageError(fmt::format("the derivative order must be in [1, {}]", degree_));
+    if (s < 0 || s >= num_segments()) throw UsageError(fmt::format("segment {} out of range [0, {})", s, num_segments()));
+    const Eigen::MatrixXd C = SmoothnessRows(order, s);
+    Eigen::MatrixXd U(degree_ + 1, kControl);
+    for (int k = 0; k <= degree_; ++k) U.row(k) = Eigen::Map<const Eigen::Matrix<double, 1, kControl>>(Control(NodeOf(s, k)));
+    return (C * U).squaredNorm();
   }
 
   /// Adds the measurement residual h(x(t)) at time t. `F` has
@@ -375,6 +389,26 @@ class PseudoSpectralProblem {
   }
 
  private:
+  // Rows sqrt(w_q L/2) u^(m)(t_q) over the controls of segment s in point order k = 0..N: their
+  // squared sum is ∫_s |u^(m)|² dt, exactly (Gauss–Legendre with N − m + 1 points).
+  Eigen::MatrixXd SmoothnessRows(int order, int s) const {
+    const int N = degree_;
+    Eigen::MatrixXd Dm = Eigen::MatrixXd::Identity(N + 1, N + 1);
+    for (int i = 0; i < order; ++i) Dm = D_ * Dm;
+    const int nq = N - order + 1;
+    Eigen::VectorXd xq, wq;
+    detail::GaussLegendre(nq, &xq, &wq);
+    Eigen::RowVectorXd row(N + 1);
+    const double length = breakpoints_[s + 1] - breakpoints_[s];
+    const double scale = std::pow(Interval(s).DerivativeScale(), order);
+    Eigen::MatrixXd coefficients(nq, N + 1);
+    for (int q = 0; q < nq; ++q) {
+      basis_.InterpolationRow(xq[q], row);
+      coefficients.row(q) = std::sqrt(wq[q] * length / 2) * scale * (row * Dm);
+    }
+    return coefficients;
+  }
+
   // Puts node g's quaternion on the manifold once (the block must already be in the problem).
   void UseManifold(int g) {
     if (manifold_set_[g]) return;
@@ -595,19 +629,21 @@ class PseudoSpectralProblem {
       set_num_residuals(static_cast<int>(coefficients_.rows()) * kControl);
     }
     const std::vector<double*>& blocks() const { return blocks_; }
+    /// A factor on every row (1/σ of a smoothness prior).
+    void set_weight(double weight) { weight_ = weight; }
     bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
       const int rows = static_cast<int>(coefficients_.rows());
       Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, kControl, Eigen::RowMajor>> r(residuals, rows, kControl);
       r.setZero();
       for (int k = 0; k < static_cast<int>(blocks_.size()); ++k) {
-        r += coefficients_.col(k) * Eigen::Map<const Eigen::Matrix<double, 1, kControl>>(parameters[k]);
+        r += weight_ * coefficients_.col(k) * Eigen::Map<const Eigen::Matrix<double, 1, kControl>>(parameters[k]);
         if (jacobians && jacobians[k]) {
           // Residual (q, i) depends on u_k[i] with coefficient C(q, k).
           Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, kControl, Eigen::RowMajor>> J(jacobians[k], rows * kControl,
                                                                                          kControl);
           J.setZero();
           for (int q = 0; q < rows; ++q) {
-            for (int i = 0; i < kControl; ++i) J(q * kControl + i, i) = coefficients_(q, k);
+            for (int i = 0; i < kControl; ++i) J(q * kControl + i, i) = weight_ * coefficients_(q, k);
           }
         }
       }
@@ -617,6 +653,7 @@ class PseudoSpectralProblem {
    private:
     std::vector<double*> blocks_;
     Eigen::MatrixXd coefficients_;
+    double weight_ = 1.0;
   };
 
   // h(x(t)): parameter blocks are the used vector blocks and the rotation of every node of the segment.
@@ -876,6 +913,7 @@ class PseudoSpectralProblem {
   std::vector<Eigen::Matrix3d> references_;
   std::vector<bool> manifold_set_;
   RightQuaternionManifold manifold_;
+  std::vector<LinearControlCost*> smoothness_costs_;  // per segment, owned by problem_
   std::unique_ptr<ceres::Problem> problem_;
 };
 

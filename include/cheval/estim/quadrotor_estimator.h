@@ -42,6 +42,14 @@ struct QuadrotorEstimateOptions {
   double sigma_rotor_rate = 100.0;
   /// m of that prior: 1 = white noise on the rotor rate Ω' (Ω a random walk), 2 = on Ω'' (1..3).
   int rotor_prior_order = 1;
+  /// Empirical Bayes for that prior's σ per segment (order 1 only; docs/estimator.md): a pilot solve
+  /// of `pilot_iterations` Levenberg–Marquardt iterations with sigma_rotor_rate everywhere, then
+  /// σ_s = max(floor, AdaptiveRotorPriorSigma), the maximum-likelihood random-walk intensity of the
+  /// pilot's rotor speeds over segments s − 1..s + 1, and the solve to convergence. false: one solve
+  /// with sigma_rotor_rate everywhere.
+  bool adaptive_rotor_prior = true;
+  int pilot_iterations = 1;                ///< Levenberg–Marquardt iterations of the pilot solve (>= 1)
+  double adaptive_rotor_prior_floor = 30;  ///< lower bound of the per-segment σ, rad/s² per s^(1/2) (> 0)
   double huber_pixels = 3.0;  ///< Huber threshold on each landmark's whitened pixel error (in σ)
   /// Window of the flatness-based initialisation (FlatnessInitialState), s (> 0).
   double initial_window_s = 0.6;
@@ -66,10 +74,10 @@ struct QuadrotorEstimate {
   int states = 0;     ///< Chebyshev nodes (segments · degree + 1), each a full state and control
   int segments = 0;
   int degree = 0;
-  int iterations = 0;
+  int iterations = 0;  ///< Levenberg–Marquardt iterations, the pilot's and the final solve's together
   double seconds = 0;         ///< wall time of building and solving the problem
   bool converged = false;     ///< Ceres reported CONVERGENCE
-  std::string solver_report;  ///< Ceres' brief report
+  std::string solver_report;  ///< Ceres' brief report (of the final solve)
   std::string solver_full_report;  ///< Ceres' full report (with the time of each stage)
   double start_time = 0, end_time = 0;
   std::vector<QuadrotorStateEstimate> samples;  ///< at the requested times inside [start, end]
@@ -86,6 +94,15 @@ struct QuadrotorEstimate {
 /// the poses and the vehicle file is used. Throws ComputeError with fewer than 3 poses.
 QuadrotorStateEstimate FlatnessInitialState(const QuadrotorParameters& vehicle, const std::vector<PoseSample>& poses,
                                             double t, double window_s);
+
+/// The maximum-likelihood σ of a white-noise-on-u' (random-walk) prior for each segment from
+/// `energy[s]` = ∫_s |u'|² dt of a pilot estimate (summed over `controls` entries) on segments of
+/// `degree`: with n increments of a random walk of intensity σ², Σ (Δu)²/Δt ≈ ∫ |u'|² has mean σ² n,
+/// so σ̂² = ∫ |u'|² / n with n = controls · degree per segment. Pooled over the segment and its
+/// neighbours (s − 1, s, s + 1 where they exist: 2–3 segments, 20–30 increments per control at
+/// degree 10), since one segment's estimate would be too noisy. Throws UsageError for degree < 1,
+/// controls < 1 or a negative energy.
+std::vector<double> AdaptiveRotorPriorSigma(const std::vector<double>& energy, int degree, int controls);
 
 /// Estimates the flight over [first, last] measurement time and returns it at `query_times` (those
 /// outside the interval are skipped). Throws UsageError for bad options, ComputeError when there are
