@@ -472,6 +472,9 @@ std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::Ve
     std::optional<CurveWindow> window = fitter.Fit(a, b, segment.begin, segment.end, may_split);
     if (window) {
       windows.push_back(std::move(*window));
+      // Progress: the samples up to this window's end are fitted (windows come in time order).
+      const auto done = std::upper_bound(t.data(), t.data() + t.size(), b) - t.data();
+      ReportProgress(options.progress, "fitting windows", done, t.size());
     } else {
       const double middle = 0.5 * (a + b);
       stack.emplace_back(middle, b);  // the left half is popped first: windows stay in time order
@@ -638,6 +641,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     if (k > 0) --k;
   }
 
+  ReportProgress(options.progress, "fitting windows", 0, m);
   for (size_t k = 0; k + 1 < starts.size(); ++k) {
     CurveSegment segment;
     segment.begin = t[starts[k]];
@@ -658,6 +662,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     curve.segments_.push_back(std::move(segment));
   }
 
+  ReportProgress(options.progress, "fitting windows", m, m);
   // Residuals at every sample.
   Eigen::MatrixXd fitted;
   curve.EvaluateMany(stamps_ns, 0, &fitted);

@@ -179,7 +179,7 @@ class Random {
   bool has_spare_ = false;
 };
 
-enum Stream : uint64_t { kShape = 1, kGaps, kDropout, kJitter, kNoise, kAddNoise, kRotationNoise };
+enum Stream : uint64_t { kShape = 1, kGaps, kDropout, kJitter, kNoise, kAddNoise, kRotationNoise, kEstimate };
 
 // ---------------------------------------------------------------------------------------------
 // The kinds. Each is p(t) = ∫_0^t u(τ) dτ + q(t) with u = Integrand (only when kIntegrated) and
@@ -765,6 +765,67 @@ traj::Trajectory Measure(const MotionModel& model, const MeasurementOptions& mea
     measured.Append(stamps[static_cast<size_t>(i)], p.data(), q.data());
   }
   return measured;
+}
+
+traj::Trajectory SimulateEstimate(const MotionModel& model, const EstimatorSimOptions& options) {
+  const MotionOptions& motion = model.options();
+  const double duration = *motion.duration_s;
+  auto require_non_negative = [](double value, const char* what) {
+    if (!(value >= 0) || !std::isfinite(value)) {
+      throw UsageError(fmt::format("{} must be a non-negative finite number, got {}", what, value));
+    }
+  };
+  if (!(options.rate_hz > 0) || !std::isfinite(options.rate_hz)) {
+    throw UsageError(fmt::format("--estimate-rate must be a positive number of Hz, got {}", options.rate_hz));
+  }
+  require_non_negative(options.velocity_random_walk, "--estimate-drift");
+  require_non_negative(options.rotation_random_walk_rad, "--estimate-rotation-drift");
+  require_non_negative(options.position_noise_m, "the estimate's position noise");
+  require_non_negative(options.velocity_noise_mps, "the estimate's velocity noise");
+  if (!(options.delay_s >= 0) || !(options.delay_s < duration)) {
+    throw UsageError(fmt::format("the estimate's delay must be in [0, {}) s, got {}", duration, options.delay_s));
+  }
+  const double span = duration - options.delay_s;
+  const int64_t count = static_cast<int64_t>(std::floor(span * options.rate_hz)) + 1;
+  if (count < 2 || count > 100'000'000) {
+    throw UsageError(fmt::format("--estimate-rate {} Hz over {} s gives {} poses; 2 to 1e8 are needed",
+                                 options.rate_hz, span, count));
+  }
+  std::vector<int64_t> stamps(static_cast<size_t>(count));
+  const int64_t first = motion.start_stamp_ns + std::llround(options.delay_s * 1e9);
+  for (int64_t i = 0; i < count; ++i) {
+    stamps[static_cast<size_t>(i)] = first + std::llround(static_cast<double>(i) * 1e9 / options.rate_hz);
+  }
+  const traj::Trajectory truth = SampleMotion(model, stamps);
+  // One stream per estimate, after the streams of the measured copy.
+  Random random(motion.seed, kEstimate + 0x100 * options.stream);
+  auto normal3 = [&random] { return Eigen::Vector3d(random.Normal(), random.Normal(), random.Normal()); };
+
+  traj::Trajectory estimate(traj::Channels{traj::OrientationKind::kQuaternion, true, false, true});
+  estimate.Reserve(truth.size());
+  const auto quaternions = truth.View().quaternions();
+  const auto velocities = truth.View().velocities();
+  Eigen::Vector3d velocity_error = Eigen::Vector3d::Zero(), position_drift = Eigen::Vector3d::Zero(),
+                  rotation_error = Eigen::Vector3d::Zero();
+  for (Eigen::Index i = 0; i < truth.size(); ++i) {
+    if (i > 0) {
+      const double dt = static_cast<double>(stamps[static_cast<size_t>(i)] - stamps[static_cast<size_t>(i - 1)]) * 1e-9;
+      position_drift += velocity_error * dt;  // the drift is the integral of the velocity error
+      velocity_error += options.velocity_random_walk * std::sqrt(dt) * normal3();
+      rotation_error += options.rotation_random_walk_rad * std::sqrt(dt) * normal3();
+    }
+    const Eigen::Vector3d p = truth.positions().col(i) + position_drift + options.position_noise_m * normal3();
+    const Eigen::Vector3d v = velocities.col(i) + velocity_error + options.velocity_noise_mps * normal3();
+    const Eigen::Vector4d q_truth = quaternions.col(i);
+    const double angle = rotation_error.norm();
+    const Eigen::Quaterniond q =
+        Eigen::Quaterniond(q_truth[3], q_truth[0], q_truth[1], q_truth[2]) *
+        Eigen::Quaterniond(Eigen::AngleAxisd(angle, angle > 0 ? Eigen::Vector3d(rotation_error / angle)
+                                                              : Eigen::Vector3d::UnitX()));
+    const double xyzw[4] = {q.x(), q.y(), q.z(), q.w()};
+    estimate.Append(stamps[static_cast<size_t>(i)], p.data(), xyzw, v.data());
+  }
+  return estimate;
 }
 
 traj::Trajectory AddPositionNoise(const traj::TrajectoryView& truth, double sigma_m, uint64_t seed) {

@@ -39,9 +39,12 @@ class CliTest : public ::testing::Test {
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
   // Runs `cheval ARGS` through the shell with stdout and stderr captured in files.
-  RunResult Cheval(const std::string& args) const {
+  RunResult Cheval(const std::string& args) const { return Shell(std::string(CHEVAL_EXE) + " " + args); }
+
+  // Runs a shell command line with stdout and stderr captured in files.
+  RunResult Shell(const std::string& command_line) const {
     const std::filesystem::path out = dir_ / "stdout", err = dir_ / "stderr";
-    const std::string command = std::string(CHEVAL_EXE) + " " + args + " >" + out.string() + " 2>" + err.string();
+    const std::string command = command_line + " >" + out.string() + " 2>" + err.string();
     const int status = std::system(command.c_str());
     RunResult run;
     run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

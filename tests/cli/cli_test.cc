@@ -119,6 +119,31 @@ TEST_F(CliTest, UsageErrorsExitWith1) {
   EXPECT_EQ(Cheval("--help").exit_code, 0);
 }
 
+// `sim motion --estimate`: simulated estimator outputs that the evaluation commands take as they are,
+// worse with more drift; a bad drift list writes no file at all.
+TEST_F(CliTest, SimulatedEstimatesAreEvaluated) {
+  RunResult sim = Cheval("sim motion --kind drone --seed 4 --duration 30 -o " + Path("m.txt") + " --truth " +
+                         Path("t.txt") + " --estimate " + Path("a.txt") + " --estimate " + Path("b.txt") +
+                         " --estimate-drift 0.001 0.01 --estimate-rate 10");
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  EXPECT_NE(sim.err.find("wrote 2 simulated estimates at 10 Hz"), std::string::npos) << sim.err;
+  RunResult ase = Cheval("ase " + Path("t.txt") + " " + Path("a.txt") + " " + Path("b.txt") + " --align se3 --json " +
+                         Path("ase.json"));
+  ASSERT_EQ(ase.exit_code, 0) << ase.err;
+  const nlohmann::json j = nlohmann::json::parse(Slurp(Path("ase.json")));
+  ASSERT_EQ(j.size(), 2u);
+  EXPECT_EQ(j[0]["stats"]["n"], 301);  // 30 s at 10 Hz, every one within 0.01 s of a 200 Hz truth pose
+  EXPECT_LT(j[0]["stats"]["rmse"].get<double>(), j[1]["stats"]["rmse"].get<double>());
+  EXPECT_GT(j[0]["parts"]["velocity"]["rmse"].get<double>(), 0.0);
+
+  RunResult bad = Cheval("sim motion --duration 5 -o " + Path("x.txt") + " --estimate " + Path("e1.txt") +
+                         " --estimate " + Path("e2.txt") + " --estimate-drift 0.1 0.2 0.3");
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_EQ(bad.err, "cheval: error: --estimate-drift: give one value or one per --estimate (2), got 3\n");
+  EXPECT_FALSE(fs::exists(Path("x.txt")));
+  EXPECT_FALSE(fs::exists(Path("e1.txt")));
+}
+
 // Velocity RMSE (m/s) of a TUM + velocity file against the truth file, pose by pose.
 double VelocityRmse(const std::string& estimate, const std::string& truth) {
   std::ifstream a(estimate), b(truth);

@@ -1,7 +1,7 @@
 // `cheval report` in a real browser: Debian's headless Chromium driven by playwright-core (from
 // report/package-lock.json; it never downloads a browser). Simulates a drone flight with the
 // project's own simulator, makes two estimates with velocity (a noisy 50 Hz copy with `cheval
-// velocity`, and the truth with a slow drift) and one without, writes the report and checks in the
+// velocity`, and a drifting odometry from `cheval sim motion --estimate`) and one without, writes the report and checks in the
 // browser that it loads with no console error or failed request, that every chart has data, that
 // the table shows the embedded numbers and that the missing velocity is said on the page; then
 // takes a full-page screenshot.
@@ -47,30 +47,16 @@ function run(...args) {
   return execFileSync(cheval, args, { cwd: work, encoding: 'utf8' });
 }
 
-// The truth with a slow drift and a velocity bias: a second estimate with velocity.
-function drifted(truthPath, outPath) {
-  const lines = fs.readFileSync(truthPath, 'utf8').split('\n').filter((l) => l && !l.startsWith('#'));
-  const t0 = Number(lines[0].split(/\s+/)[0]);
-  const out = lines.map((line) => {
-    const f = line.split(/\s+/);
-    const t = Number(f[0]) - t0;
-    const drift = [0.004 * t, -0.003 * t, 0.001 * t];
-    const position = [1, 2, 3].map((c, a) => (Number(f[c]) + drift[a] + 0.05 * Math.sin(0.7 * t + a)).toFixed(6));
-    const velocity = [8, 9, 10].map((c, a) => (Number(f[c]) + [0.004, -0.003, 0.001][a] + 0.035 * Math.cos(0.7 * t + a)).toFixed(6));
-    return [f[0], ...position, ...f.slice(4, 8), ...velocity].join(' ');
-  });
-  fs.writeFileSync(outPath, out.join('\n') + '\n');
-}
-
 const work = fs.mkdtempSync(path.join(os.tmpdir(), 'cheval_report_browser_'));
 const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'cheval_report_chromium_'));
 
 async function main() {
-  run('sim', 'motion', '--kind', 'drone', '--seed', '1', '--noise', '0.0005', '--duration', '60', '-o', 'mocap.tum', '--truth', 'truth.tumv');
+  // The reference (0.5 mm motion capture) and a simulated odometry output with drifting errors.
+  run('sim', 'motion', '--kind', 'drone', '--seed', '1', '--noise', '0.0005', '--duration', '60', '-o', 'mocap.tum',
+    '--estimate', 'drifting.tumv', '--estimate-drift', '0.003', '--estimate-rate', '200');
   run('sim', 'motion', '--kind', 'drone', '--seed', '1', '--noise', '0.01', '--rotation-noise', '0.003', '--duration', '60',
     '--rate', '50', '-o', 'noisy.tum');
   run('velocity', 'noisy.tum', '-o', 'noisy_velocity.tumv');
-  drifted(path.join(work, 'truth.tumv'), path.join(work, 'drifting.tumv'));
   run('sim', 'motion', '--kind', 'drone', '--seed', '1', '--noise', '0.03', '--duration', '60', '--rate', '20', '-o', 'poses_only.tum');
   const printed = run('report', 'mocap.tum', 'noisy_velocity.tumv', 'drifting.tumv', 'poses_only.tum', '-o', 'report.html');
   process.stdout.write(printed);

@@ -425,3 +425,83 @@ TEST(AddPositionNoise, KeepsStampsAndOrientationsAndAddsTheAskedSigma) {
 
 }  // namespace
 }  // namespace cheval::sim
+
+namespace cheval::sim {
+namespace {
+
+// The simulated estimator: its stamps, that with no error it is the truth, that its position drift is
+// exactly the integral of its velocity error (as in a filter), determinism, streams, bad values.
+TEST(SimulateEstimate, NoErrorIsTheTruthAtItsOwnRate) {
+  const MotionModel model = Model(MotionKind::kDrone, 3);
+  EstimatorSimOptions options;
+  options.rate_hz = 20;
+  options.velocity_random_walk = options.position_noise_m = options.velocity_noise_mps = 0;
+  options.rotation_random_walk_rad = 0;
+  options.delay_s = 0.5;
+  const traj::Trajectory estimate = SimulateEstimate(model, options);
+  ASSERT_TRUE(estimate.channels().velocity);
+  const double duration = *model.options().duration_s;
+  EXPECT_EQ(estimate.size(), static_cast<Eigen::Index>(std::floor((duration - 0.5) * 20)) + 1);
+  EXPECT_EQ(estimate.stamps_ns()[0], model.options().start_stamp_ns + 500'000'000);
+  EXPECT_EQ(estimate.stamps_ns()[1] - estimate.stamps_ns()[0], 50'000'000);
+  const traj::Trajectory truth = SampleMotion(model, estimate.stamps_ns());
+  EXPECT_LT((estimate.positions() - truth.positions()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((estimate.View().velocities() - truth.View().velocities()).cwiseAbs().maxCoeff(), 1e-12);
+  for (Eigen::Index i = 0; i < estimate.size(); ++i) {
+    EXPECT_LT((estimate.Rotation(i) - truth.Rotation(i)).norm(), 1e-12) << i;
+  }
+}
+
+TEST(SimulateEstimate, PositionDriftIsTheIntegralOfTheVelocityError) {
+  const MotionModel model = Model(MotionKind::kCar, 2);
+  EstimatorSimOptions options;
+  options.position_noise_m = options.velocity_noise_mps = 0;  // drift only
+  options.velocity_random_walk = 0.01;
+  const traj::Trajectory estimate = SimulateEstimate(model, options);
+  const traj::Trajectory truth = SampleMotion(model, estimate.stamps_ns());
+  const Eigen::Matrix3Xd position_error = estimate.positions() - truth.positions();
+  const Eigen::Matrix3Xd velocity_error = estimate.View().velocities() - truth.View().velocities();
+  EXPECT_LT(position_error.col(0).norm(), 1e-12);  // starts without error
+  for (Eigen::Index i = 0; i + 1 < estimate.size(); ++i) {
+    const double dt = static_cast<double>(estimate.stamps_ns()[i + 1] - estimate.stamps_ns()[i]) * 1e-9;
+    ASSERT_LT((position_error.col(i + 1) - position_error.col(i) - dt * velocity_error.col(i)).norm(), 1e-9) << i;
+  }
+  // A random walk of 0.01 m/s per sqrt(s) over 100 s: the velocity error is some cm/s at the end, not 0.
+  const double final_velocity_error = velocity_error.col(estimate.size() - 1).norm();
+  EXPECT_GT(final_velocity_error, 1e-3);
+  EXPECT_LT(final_velocity_error, 1.0);
+}
+
+TEST(SimulateEstimate, DeterministicPerSeedAndStream) {
+  const MotionModel model = Model(MotionKind::kHandheld, 5);
+  EstimatorSimOptions options;
+  const traj::Trajectory a = SimulateEstimate(model, options), again = SimulateEstimate(model, options);
+  EXPECT_EQ(a.raw_positions(), again.raw_positions());
+  EXPECT_EQ(a.raw_velocities(), again.raw_velocities());
+  options.stream = 1;
+  const traj::Trajectory b = SimulateEstimate(model, options);
+  EXPECT_NE(a.raw_positions(), b.raw_positions());
+}
+
+TEST(SimulateEstimate, BadValuesNameTheOption) {
+  const MotionModel model = Model(MotionKind::kDrone);
+  auto message = [&model](auto change) {
+    EstimatorSimOptions options;
+    change(options);
+    try {
+      SimulateEstimate(model, options);
+    } catch (const UsageError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message([](EstimatorSimOptions& o) { o.rate_hz = 0; }), "--estimate-rate must be a positive number of Hz, got 0");
+  EXPECT_EQ(message([](EstimatorSimOptions& o) { o.velocity_random_walk = -1; }),
+            "--estimate-drift must be a non-negative finite number, got -1");
+  EXPECT_EQ(message([](EstimatorSimOptions& o) { o.rotation_random_walk_rad = std::nan(""); }),
+            "--estimate-rotation-drift must be a non-negative finite number, got nan");
+  EXPECT_EQ(message([](EstimatorSimOptions& o) { o.delay_s = 60; }), "the estimate's delay must be in [0, 60) s, got 60");
+}
+
+}  // namespace
+}  // namespace cheval::sim

@@ -10,6 +10,7 @@
 #include "cheval/common/error.h"
 #include "cheval/traj/stamp.h"
 #include "common.h"
+#include "progress.h"
 
 namespace cheval::cli {
 namespace {
@@ -79,6 +80,7 @@ void RegisterCompress(CLI::App& app, Action* action) {
       const traj::TrajectoryView view = trajectory.View();
       if (!view.has_stamps()) throw ComputeError("compress needs stamps; give the KITTI times with --kitti-times");
       const Eigen::MatrixXd positions = view.positions().transpose();
+      options.curve.progress = Progress().Fn();  // on a terminal only
       const cheb::Compression result = cheb::Compress(view.stamps_ns(), positions, options);
       const std::string text = cheb::WriteModelJson(result.model);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -4,6 +4,7 @@
 #include "cheval/common/error.h"
 #include "cheval/traj/stamp.h"
 #include "common.h"
+#include "progress.h"
 
 namespace cheval::cli {
 namespace {
@@ -51,7 +52,7 @@ void RegisterConvert(CLI::App& app, Action* action) {
       }
       traj::WriteFileAtomically(flags->output, text);
       if (!times.empty()) traj::WriteFileAtomically(flags->times_output, times);
-      fmt::print(stderr, "wrote {} poses to {} ({})\n", trajectory.size(), flags->output, traj::ToString(to));
+      if (!Quiet()) fmt::print(stderr, "wrote {} poses to {} ({})\n", trajectory.size(), flags->output, traj::ToString(to));
     };
   });
 }

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "cheval/common/error.h"
+#include "progress.h"
 #include "cheval/traj/stamp.h"
 
 namespace cheval::cli {
@@ -54,6 +55,7 @@ eval::EvaluationOptions ToEvaluationOptions(eval::MetricKind metric, const EvalF
   options.estimate_velocity_body_frame = flags.velocity_frame == "body";
   options.pose_only = flags.pose_only;
   eval::ValidateEvaluationOptions(options);
+  options.velocity.curve.progress = Progress().Fn();  // the reference fit of C-ASE, on a terminal only
   return options;
 }
 

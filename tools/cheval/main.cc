@@ -7,6 +7,7 @@
 
 #include "cheval/common/error.h"
 #include "common.h"
+#include "progress.h"
 
 int main(int argc, char** argv) {
   using cheval::ExitCode;
@@ -14,6 +15,10 @@ int main(int argc, char** argv) {
                "cheval"};
   app.set_version_flag("--version", std::string(CHEVAL_VERSION));
   app.require_subcommand(1);
+  // Global flags may also follow the subcommand (`cheval velocity IN -o OUT --quiet`).
+  app.fallthrough();
+  bool quiet = false;
+  app.add_flag("-q,--quiet", quiet, "No progress display and no informational lines on stderr (errors and warnings stay)");
   cheval::cli::Action action;
   cheval::cli::RegisterInfo(app, &action);
   cheval::cli::RegisterConvert(app, &action);
@@ -44,6 +49,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return fail(ExitCode::kUsage, fmt::format("cheval: error: {}\nRun 'cheval --help' for usage.", e.what()));
   }
+  cheval::cli::SetQuiet(quiet);
   try {
     if (action) action();
     return static_cast<int>(ExitCode::kOk);

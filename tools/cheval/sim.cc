@@ -3,10 +3,14 @@
 #include <fmt/format.h>
 
 #include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "cheval/common/error.h"
 #include "cheval/sim/motion.h"
 #include "common.h"
+#include "progress.h"
 
 namespace cheval::cli {
 namespace {
@@ -19,7 +23,26 @@ struct SimMotionFlags {
   sim::MeasurementOptions measurement;
   std::string output;
   std::string truth_output;
+  std::vector<std::string> estimate_outputs;  // --estimate, repeatable: one simulated estimator each
+  sim::EstimatorSimOptions estimator;
+  std::vector<double> estimate_drifts;  // --estimate-drift: one value for all, or one per estimate
 };
+
+// Writes every (path, text) atomically; if one cannot be written, those already written are removed
+// again, so a failure leaves none of them behind.
+void WriteAllOrNone(const std::vector<std::pair<std::string, std::string>>& files) {
+  for (size_t i = 0; i < files.size(); ++i) {
+    try {
+      traj::WriteFileAtomically(files[i].first, files[i].second);
+    } catch (...) {
+      for (size_t k = 0; k < i; ++k) {
+        std::error_code ignored;
+        std::filesystem::remove(files[k].first, ignored);
+      }
+      throw;
+    }
+  }
+}
 
 }  // namespace
 
@@ -55,9 +78,25 @@ void RegisterSim(CLI::App& app, Action* action) {
   motion->add_option("--gap-seconds", flags->measurement.gap_s, "Length of each gap (s)")->capture_default_str();
   motion->add_option("-o,--output", flags->output, "Measured trajectory (TUM)")->required();
   motion->add_option("--truth", flags->truth_output, "Exact trajectory on the nominal grid (TUM + velocity)");
+  motion->add_option("--estimate", flags->estimate_outputs,
+                     "A simulated estimator's output (TUM + velocity, drifting like an odometry); repeat for several");
+  motion->add_option("--estimate-rate", flags->estimator.rate_hz, "Rate of the estimates (Hz)")->capture_default_str();
+  motion
+      ->add_option("--estimate-drift", flags->estimate_drifts,
+                   "Random walk of the estimates' velocity error (m/s per sqrt(s)): one value, or one per --estimate")
+      ->default_str(fmt::format("{}", flags->estimator.velocity_random_walk));
+  motion
+      ->add_option("--estimate-rotation-drift", flags->estimator.rotation_random_walk_rad,
+                   "Random walk of the estimates' orientation error (rad per sqrt(s))")
+      ->capture_default_str();
   motion->callback([flags, action, duration, rate] {
     const bool duration_given = duration->count() > 0, rate_given = rate->count() > 0;
     *action = [flags, duration_given, rate_given] {
+      const size_t n_estimates = flags->estimate_outputs.size();
+      if (flags->estimate_drifts.size() > 1 && flags->estimate_drifts.size() != n_estimates) {
+        throw UsageError(fmt::format("--estimate-drift: give one value or one per --estimate ({}), got {}",
+                                     n_estimates, flags->estimate_drifts.size()));
+      }
       sim::MotionOptions options;
       options.kind = *sim::MotionKindFromString(flags->kind);
       options.seed = flags->seed;
@@ -66,23 +105,24 @@ void RegisterSim(CLI::App& app, Action* action) {
       const sim::MotionModel model(options);
       const traj::Trajectory measured = sim::Measure(model, flags->measurement);
       const traj::Trajectory truth = sim::GenerateMotion(model);
-      // Everything is formatted before anything is written; if the second file cannot be written the
-      // first is removed again, so a failure leaves neither behind.
-      const std::string measured_text = traj::FormatTrajectory(measured.View(), traj::Format::kTum);
-      const std::string truth_text =
-          flags->truth_output.empty() ? "" : traj::FormatTrajectory(truth.View(), traj::Format::kTumV);
-      traj::WriteFileAtomically(flags->output, measured_text);
+      // Everything is formatted before anything is written.
+      std::vector<std::pair<std::string, std::string>> files;
+      files.emplace_back(flags->output, traj::FormatTrajectory(measured.View(), traj::Format::kTum));
       if (!flags->truth_output.empty()) {
-        try {
-          traj::WriteFileAtomically(flags->truth_output, truth_text);
-        } catch (...) {
-          std::error_code ignored;
-          std::filesystem::remove(flags->output, ignored);
-          throw;
-        }
+        files.emplace_back(flags->truth_output, traj::FormatTrajectory(truth.View(), traj::Format::kTumV));
       }
+      for (size_t k = 0; k < n_estimates; ++k) {
+        sim::EstimatorSimOptions estimator = flags->estimator;
+        estimator.stream = k;
+        if (!flags->estimate_drifts.empty()) {
+          estimator.velocity_random_walk = flags->estimate_drifts[flags->estimate_drifts.size() == 1 ? 0 : k];
+        }
+        const traj::Trajectory estimate = sim::SimulateEstimate(model, estimator);
+        files.emplace_back(flags->estimate_outputs[k], traj::FormatTrajectory(estimate.View(), traj::Format::kTumV));
+      }
+      WriteAllOrNone(files);
       const sim::MotionOptions& used = model.options();
-      fmt::print(stderr,
+      if (!Quiet()) fmt::print(stderr,
                  "wrote {} measured poses ({}, {} s at {} Hz, seed {}; noise {} m, jitter {} s, {} removed by dropouts "
                  "and gaps) to {}{}\n",
                  measured.size(), sim::ToString(used.kind), *used.duration_s, *used.rate_hz, used.seed,
@@ -90,6 +130,10 @@ void RegisterSim(CLI::App& app, Action* action) {
                  flags->truth_output.empty()
                      ? ""
                      : fmt::format(" and {} exact poses to {}", truth.size(), flags->truth_output));
+      if (!Quiet() && n_estimates > 0) {
+        fmt::print(stderr, "wrote {} simulated estimate{} at {} Hz\n", n_estimates, n_estimates > 1 ? "s" : "",
+                   flags->estimator.rate_hz);
+      }
     };
   });
 }

@@ -11,6 +11,7 @@
 #include "cheval/eval/velocity.h"
 #include "cheval/traj/stamp.h"
 #include "common.h"
+#include "progress.h"
 
 namespace cheval::cli {
 namespace {
@@ -62,6 +63,7 @@ eval::VelocityOptions ToOptions(const VelocityFlags& flags, const traj::Trajecto
       options.curve.window_s = flags.window_s;
     }
   }
+  options.curve.progress = Progress().Fn();  // on a terminal only (progress.h)
   return options;
 }
 

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "cheval/common/progress.h"
 #include "cheval/cheb/fit.h"
 
 namespace cheval::cheb {
@@ -71,6 +72,8 @@ struct CurveOptions {
   bool end_velocity_risk = false;
   /// Fit a single window over each gap-free segment (no splitting), e.g. to reproduce a global fit.
   bool single_window = false;
+  /// Told "fitting windows" with the samples fitted so far, as windows are accepted (may be empty).
+  ProgressFn progress;
 };
 
 /// One window: its core [core_begin, core_end] (seconds from the curve's origin), the samples used

@@ -143,6 +143,27 @@ traj::Trajectory GenerateMotion(const MotionOptions& options);
 /// in the duration, or when fewer than 2 samples would remain.
 traj::Trajectory Measure(const MotionModel& model, const MeasurementOptions& measurement);
 
+/// How a simulated state estimator (a visual-inertial odometry, say) errs: what `cheval sim motion
+/// --estimate` writes, so that evaluation (APE, RPE, ASE) and reports can be shown on data cheval
+/// makes itself. The errors drift as an odometry's do: the velocity error b(t) is a random walk,
+/// the position error is its integral plus white noise (so position drift and velocity error are
+/// consistent, as in a filter), and the orientation error is a random walk on SO(3).
+struct EstimatorSimOptions {
+  double rate_hz = 20.0;                          ///< --estimate-rate: output rate, > 0 Hz
+  double velocity_random_walk = 0.002;            ///< --estimate-drift: σ of b's random walk, m/s per √s, >= 0
+  double position_noise_m = 0.002;                ///< white noise on each position coordinate, m, >= 0
+  double velocity_noise_mps = 0.005;              ///< white noise on each velocity coordinate, m/s, >= 0
+  double rotation_random_walk_rad = 0.002;        ///< --estimate-rotation-drift: rad per √s, >= 0
+  double delay_s = 0.0;                           ///< stamps start this long after the truth's start, [0, duration)
+  uint64_t stream = 0;                            ///< distinguishes several estimates of one model and seed
+};
+
+/// A simulated estimator's output for `model`: TUM + velocity (positions, R_world_body quaternions,
+/// world-frame velocities) at options.rate_hz from the model's start (+ delay_s) to its duration,
+/// with the errors of EstimatorSimOptions, starting from zero error. Deterministic in the model's
+/// seed and options.stream. Throws UsageError naming the CLI option for a bad value.
+traj::Trajectory SimulateEstimate(const MotionModel& model, const EstimatorSimOptions& options);
+
 /// A copy of any `truth` without velocity channels and with N(0, sigma_m²) noise on every position
 /// coordinate (metres), drawn from a generator seeded with `seed`; stamps and orientations are kept.
 /// Throws UsageError ("--noise ...") unless sigma_m is finite and >= 0.
