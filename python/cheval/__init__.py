@@ -41,7 +41,11 @@ __all__ = [
     "Trajectory", "Curve", "Model", "Compression",
     "read", "write", "simulate", "velocity", "fit", "compress", "sample", "read_model", "write_model",
     "associate", "align", "ape", "rpe", "ase",
+    "DEFAULT_VEHICLE", "simulate_quadrotor", "estimate_quadrotor",
 ]
+
+#: The FlightGoggles quadrotor and camera (docs/estimator.md), the estimator's default vehicle file.
+DEFAULT_VEHICLE = _os.path.join(_os.path.dirname(__file__), "vehicles", "flightgoggles.json")
 
 for _cls in (Trajectory, Curve, Model, Compression):
     _cls.__module__ = "cheval"  # shown as cheval.Trajectory, where users find them
@@ -263,3 +267,35 @@ ase.__doc__ = """Absolute State Error on SE_2(3), as ``cheval ase`` (rotation, p
     velocity_frame: the estimate's velocity columns are 'world' or 'body'; pose_only: rotation +
     position only, for estimates without velocity.
 """ + _COMMON_DOC
+
+
+def simulate_quadrotor(scenario, output, *, seed=1, duration=10.0, vehicle=DEFAULT_VEHICLE):
+    """Simulates a quadrotor flight seen by a camera and writes its data folder, as ``cheval sim
+    quadrotor`` (docs/estimator.md): vehicle.json, landmarks.csv, measurements.csv, initial.csv and
+    truth.csv in ``output``. scenario: 'hover', 'line', 'circle', 'figure8', 'lissajous' or
+    'aggressive'; vehicle: a vehicle + camera JSON file.
+    """
+    _cheval.simulate_quadrotor(scenario, _os.fspath(output), seed, float(duration), _os.fspath(vehicle))
+
+
+def estimate_quadrotor(*, scenario=None, data=None, seed=1, duration=10.0, vehicle=None, degree=10, segment=1.0):
+    """States and rotor speeds of a quadrotor from camera measurements and its dynamics, as ``cheval
+    estimate quadrotor`` (docs/estimator.md). Give a data folder (``data=``, as written by
+    simulate_quadrotor; its vehicle.json unless ``vehicle`` is given) or a scenario to simulate
+    (``scenario=``, with ``seed``, ``duration`` and ``vehicle``, default DEFAULT_VEHICLE).
+
+    Returns the dict of ``cheval estimate quadrotor --json`` (states, segments, degree, iterations,
+    seconds, converged and, with a ground truth, rotor_error_rpm, rotor_error_percent,
+    position_rmse_m, rotation_rmse_deg, velocity_rmse_mps) plus 'estimate': numpy arrays 'times'
+    (n,) s, 'positions' (n, 3), 'quaternions' (n, 4) x y z w (R_world_body), 'velocities' (n, 3)
+    world m/s, 'angular_velocities' (n, 3) body rad/s, 'rotor_speeds' (n, 4) rad/s, at the truth's
+    times (else every 10 ms).
+    """
+    if scenario is not None and vehicle is None:
+        vehicle = DEFAULT_VEHICLE
+    text, arrays = _cheval.estimate_quadrotor(scenario, None if data is None else _os.fspath(data), seed,
+                                              float(duration), None if vehicle is None else _os.fspath(vehicle),
+                                              int(degree), float(segment))
+    result = _json.loads(text)
+    result["estimate"] = arrays
+    return result

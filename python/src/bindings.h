@@ -86,5 +86,6 @@ void BindErrors(py::module_& m);
 void BindTrajectory(py::module_& m);
 void BindChebyshev(py::module_& m);
 void BindEvaluation(py::module_& m);
+void BindEstimator(py::module_& m);
 
 }  // namespace cheval::python

@@ -112,4 +112,5 @@ PYBIND11_MODULE(_cheval, m) {
   cheval::python::BindTrajectory(m);
   cheval::python::BindChebyshev(m);
   cheval::python::BindEvaluation(m);
+  cheval::python::BindEstimator(m);
 }

@@ -12,6 +12,8 @@
 #include <random>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "cheval/common/error.h"
 #include "cheval/lie/so3.h"
 #include "cheval/traj/io.h"
@@ -491,14 +493,53 @@ void WriteQuadrotorData(const QuadrotorData& data, const std::string& folder) {
                         Num(s.q.x()), Num(s.q.y()), Num(s.q.z()));
   }
   WriteText(dir / "initial.csv", text);
-  text = "t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,rotor0,rotor1,rotor2,rotor3\n";
-  for (const QuadrotorTruth& s : data.truth) {
+  if (!data.truth.empty()) WriteText(dir / "truth.csv", QuadrotorStatesCsv(data.truth));
+}
+
+std::vector<double> ReportTimes(const QuadrotorData& data) {
+  std::vector<double> times;
+  for (const QuadrotorTruth& t : data.truth) times.push_back(t.t);
+  if (times.empty() && !data.initial.empty()) {
+    const double first = data.initial.front().t, last = data.initial.back().t;
+    for (int64_t k = 0; first + 0.01 * static_cast<double>(k) <= last; ++k) {
+      times.push_back(first + 0.01 * static_cast<double>(k));
+    }
+  }
+  return times;
+}
+
+std::vector<QuadrotorTruth> EstimatedStates(const estim::QuadrotorEstimate& estimate) {
+  std::vector<QuadrotorTruth> states;
+  states.reserve(estimate.samples.size());
+  for (const estim::QuadrotorStateEstimate& s : estimate.samples) {
+    states.push_back({s.t, s.p, Eigen::Quaterniond(s.R).normalized(), s.v, s.w, s.rotor});
+  }
+  return states;
+}
+
+std::string QuadrotorStatesCsv(const std::vector<QuadrotorTruth>& states) {
+  std::string text = "t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,rotor0,rotor1,rotor2,rotor3\n";
+  for (const QuadrotorTruth& s : states) {
     text += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", Num(s.t), Num(s.p.x()), Num(s.p.y()),
                         Num(s.p.z()), Num(s.q.w()), Num(s.q.x()), Num(s.q.y()), Num(s.q.z()), Num(s.v.x()),
                         Num(s.v.y()), Num(s.v.z()), Num(s.w.x()), Num(s.w.y()), Num(s.w.z()), Num(s.rotor[0]),
                         Num(s.rotor[1]), Num(s.rotor[2]), Num(s.rotor[3]));
   }
-  if (!data.truth.empty()) WriteText(dir / "truth.csv", text);
+  return text;
+}
+
+std::string QuadrotorEstimateJson(const estim::QuadrotorEstimate& e, const QuadrotorErrors* errors) {
+  nlohmann::ordered_json j = {{"states", e.states},         {"segments", e.segments}, {"degree", e.degree},
+                              {"iterations", e.iterations}, {"seconds", e.seconds},   {"converged", e.converged}};
+  if (errors != nullptr) {
+    auto four = [](const Eigen::Vector4d& v) { return nlohmann::ordered_json::array({v[0], v[1], v[2], v[3]}); };
+    j["rotor_error_rpm"] = four(errors->rotor_error_rpm);
+    j["rotor_error_percent"] = four(errors->rotor_error_percent);
+    j["position_rmse_m"] = errors->position_rmse_m;
+    j["rotation_rmse_deg"] = errors->rotation_rmse_deg;
+    j["velocity_rmse_mps"] = errors->velocity_rmse_mps;
+  }
+  return j.dump(2) + "\n";
 }
 
 QuadrotorData ReadQuadrotorData(const std::string& folder) {

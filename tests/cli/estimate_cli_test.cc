@@ -2,7 +2,10 @@
 // printed figures and the JSON keys of issue 5, and every bad input with its documented exit code.
 #include <filesystem>
 #include <fstream>
+#include <cmath>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -16,6 +19,21 @@ namespace fs = std::filesystem;
 using cheval::testing::CliTest;
 using cheval::testing::RunResult;
 using cheval::testing::Slurp;
+
+// The numbers of a CSV text with a header line, row by row.
+std::vector<std::vector<double>> CsvRows(const std::string& text) {
+  std::vector<std::vector<double>> rows;
+  std::istringstream lines(text);
+  std::string line;
+  std::getline(lines, line);  // header
+  while (std::getline(lines, line)) {
+    std::vector<double> row;
+    std::istringstream fields(line);
+    for (std::string field; std::getline(fields, field, ',');) row.push_back(std::stod(field));
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
 
 TEST_F(CliTest, SimulateThenEstimateFromTheFolder) {
   RunResult sim = Cheval("sim quadrotor --scenario figure8 --seed 2 --duration 3 -o " + Path("flight"));
@@ -38,12 +56,33 @@ TEST_F(CliTest, SimulateThenEstimateFromTheFolder) {
   for (const auto& e : j["rotor_error_percent"]) EXPECT_LT(e.get<double>(), 1.5);
   EXPECT_LT(j["position_rmse_m"].get<double>(), 0.02);
 
-  // Without truth.csv the estimate still runs and prints no errors.
+  // -o: the estimated states in truth.csv's layout, at the truth's times; the position RMSE computed
+  // from the two files is the one the JSON reports.
+  RunResult with_states = Cheval("estimate quadrotor --data " + Path("flight") + " -o " + Path("states.csv"));
+  ASSERT_EQ(with_states.exit_code, 0) << with_states.err;
+  const std::vector<std::vector<double>> truth = CsvRows(Slurp(dir_ / "flight" / "truth.csv"));
+  const std::vector<std::vector<double>> states = CsvRows(Slurp(Path("states.csv")));
+  const auto header = [](const std::string& text) { return text.substr(0, text.find('\n')); };
+  EXPECT_EQ(header(Slurp(Path("states.csv"))), header(Slurp(dir_ / "flight" / "truth.csv")));
+  ASSERT_EQ(states.size(), truth.size());
+  double p2 = 0;
+  for (size_t i = 0; i < states.size(); ++i) {
+    ASSERT_EQ(states[i].size(), 18u);
+    EXPECT_EQ(states[i][0], truth[i][0]);
+    for (int k = 1; k <= 3; ++k) p2 += (states[i][k] - truth[i][k]) * (states[i][k] - truth[i][k]);
+  }
+  EXPECT_NEAR(std::sqrt(p2 / static_cast<double>(states.size())), j["position_rmse_m"].get<double>(), 1e-9);
+
+  // Without truth.csv the estimate still runs and prints no errors; -o then samples every 10 ms.
   fs::remove(dir_ / "flight" / "truth.csv");
-  RunResult no_truth = Cheval("estimate quadrotor --data " + Path("flight") + " --json " + Path("n.json"));
+  RunResult no_truth = Cheval("estimate quadrotor --data " + Path("flight") + " --json " + Path("n.json") + " -o " +
+                              Path("s2.csv"));
   ASSERT_EQ(no_truth.exit_code, 0) << no_truth.err;
   EXPECT_NE(no_truth.out.find("no truth.csv"), std::string::npos);
   EXPECT_FALSE(nlohmann::json::parse(Slurp(Path("n.json"))).contains("rotor_error_percent"));
+  const std::vector<std::vector<double>> sampled = CsvRows(Slurp(Path("s2.csv")));
+  ASSERT_GE(sampled.size(), 250u);  // ~3 s of frames at 100 Hz
+  EXPECT_NEAR(sampled[1][0] - sampled[0][0], 0.01, 1e-12);
 }
 
 // --vehicle replaces the folder's vehicle: a 20 % heavier (wrong) mass makes the rotor speeds come

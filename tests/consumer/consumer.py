@@ -21,4 +21,7 @@ try:
     raise AssertionError("an alignment from 2 pairs must fail")
 except cheval.ComputeError as e:
     assert "at least 3 associated pairs, got 2" in str(e), e
+assert os.path.realpath(cheval.DEFAULT_VEHICLE).startswith(where), cheval.DEFAULT_VEHICLE  # inside the package
+r = cheval.estimate_quadrotor(scenario="hover", duration=1)
+assert r["segments"] == 1 and len(r["estimate"]["times"]) == 101, r
 print(f"cheval imported from {where}; {len(t)} poses")

@@ -12,6 +12,10 @@ cmake -S "$source/tests/consumer" -B "$work/build" -DCMAKE_PREFIX_PATH="$work/pr
 cmake --build "$work/build" >/dev/null
 "$work/build/consumer"
 test -x "$work/prefix/bin/cheval"
+# The installed executable and its default vehicle file (PREFIX/share/cheval/vehicles).
+test -f "$work/prefix/share/cheval/vehicles/flightgoggles.json"
+"$work/prefix/bin/cheval" sim quadrotor --scenario hover --duration 1 -o "$work/flight" --quiet
+cmp "$work/prefix/share/cheval/vehicles/flightgoggles.json" "$source/data/vehicles/flightgoggles.json"
 
 # The Python module, when built: the interpreter and install folder are the build's own settings.
 cached() { sed -n "s/^$1:[A-Z]*=//p" "$build/CMakeCache.txt"; }

@@ -3,27 +3,43 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <memory>
-#include <nlohmann/json.hpp>
+#include <optional>
 
 #include "cheval/common/error.h"
 #include "cheval/estim/quadrotor_estimator.h"
 #include "cheval/sim/quadrotor.h"
 #include "cheval/traj/io.h"
 #include "common.h"
+#include "progress.h"
 
 namespace cheval::cli {
 namespace {
+
+// The default vehicle file: the installed one (PREFIX/share/cheval/vehicles beside PREFIX/bin/cheval),
+// else the source tree's (running from a build folder).
+std::string DefaultVehicle() {
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const std::filesystem::path installed =
+        exe.parent_path().parent_path() / "share" / "cheval" / "vehicles" / "flightgoggles.json";
+    if (std::filesystem::is_regular_file(installed, ec)) return installed.string();
+  }
+  return CHEVAL_DEFAULT_VEHICLE;
+}
 
 struct QuadrotorFlags {
   std::string scenario;
   uint64_t seed = 1;
   double duration_s = 10.0;
-  std::string vehicle = CHEVAL_DEFAULT_VEHICLE;
+  std::string vehicle = DefaultVehicle();
   std::string data;
   std::string output;
   std::string json;
+  std::string states_output;  // estimate -o: the estimated states, truth.csv's layout
   estim::QuadrotorEstimateOptions options;
 };
 
@@ -63,7 +79,7 @@ void RegisterSimQuadrotor(CLI::App& app, Action* action) {
       const estim::Vehicle vehicle = estim::ReadVehicle(flags->vehicle);
       const sim::QuadrotorData data = sim::SimulateQuadrotor(vehicle, SimOptions(*flags));
       sim::WriteQuadrotorData(data, flags->output);
-      fmt::print(stderr, "wrote {} ({} s, seed {}): {} frames, {} pixel measurements, {} landmarks, {} truth samples to {}\n",
+      if (!Quiet()) fmt::print(stderr, "wrote {} ({} s, seed {}): {} frames, {} pixel measurements, {} landmarks, {} truth samples to {}\n",
                  flags->scenario, flags->duration_s, flags->seed, data.initial.size(), data.pixels.size(),
                  data.landmarks.size(), data.truth.size(), flags->output);
     };
@@ -83,6 +99,9 @@ void RegisterEstimate(CLI::App& app, Action* action) {
   quad->add_option("--degree", flags->options.degree, "Polynomial degree per segment")->capture_default_str();
   quad->add_option("--segment", flags->options.segment_s, "Segment length (s)")->capture_default_str();
   quad->add_option("--json", flags->json, "Write the result as JSON");
+  quad->add_option("-o,--output", flags->states_output,
+                   "Write the estimated states and rotor speeds as CSV (truth.csv's columns), at the truth's times, "
+                   "else every 10 ms");
   quad->callback([flags, action, quad] {
     const bool has_scenario = quad->get_option("--scenario")->count() > 0;
     const bool has_data = quad->get_option("--data")->count() > 0;
@@ -97,36 +116,31 @@ void RegisterEstimate(CLI::App& app, Action* action) {
       } else {
         data = sim::SimulateQuadrotor(estim::ReadVehicle(flags->vehicle), SimOptions(*flags));
       }
-      std::vector<double> times;
-      for (const sim::QuadrotorTruth& t : data.truth) times.push_back(t.t);
+      const std::vector<double> times = sim::ReportTimes(data);  // the truth's, else every 10 ms
       const estim::QuadrotorEstimate e =
           estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, flags->options, times);
       fmt::print("states              {}\nsegments            {}\ndegree              {}\n", e.states, e.segments,
                  e.degree);
       fmt::print("solver iterations   {}{}\nseconds             {:.3f}\n", e.iterations,
                  e.converged ? "" : "  (did not converge)", e.seconds);
-      nlohmann::json j = {{"states", e.states},     {"segments", e.segments},   {"degree", e.degree},
-                          {"iterations", e.iterations}, {"seconds", e.seconds}, {"converged", e.converged}};
+      std::optional<sim::QuadrotorErrors> errors;
       if (!data.truth.empty()) {
-        const sim::QuadrotorErrors errors = sim::CompareWithTruth(e, data.truth);
-        fmt::print("rotor error rpm     {:.2f} {:.2f} {:.2f} {:.2f}\n", errors.rotor_error_rpm[0],
-                   errors.rotor_error_rpm[1], errors.rotor_error_rpm[2], errors.rotor_error_rpm[3]);
-        fmt::print("rotor error %       {:.3f} {:.3f} {:.3f} {:.3f}\n", errors.rotor_error_percent[0],
-                   errors.rotor_error_percent[1], errors.rotor_error_percent[2], errors.rotor_error_percent[3]);
+        errors = sim::CompareWithTruth(e, data.truth);
+        const Eigen::Vector4d& rpm = errors->rotor_error_rpm;
+        const Eigen::Vector4d& percent = errors->rotor_error_percent;
+        fmt::print("rotor error rpm     {:.2f} {:.2f} {:.2f} {:.2f}\n", rpm[0], rpm[1], rpm[2], rpm[3]);
+        fmt::print("rotor error %       {:.3f} {:.3f} {:.3f} {:.3f}\n", percent[0], percent[1], percent[2], percent[3]);
         fmt::print("position RMSE       {:.4f} m\nrotation RMSE       {:.3f} deg\nvelocity RMSE       {:.4f} m/s\n",
-                   errors.position_rmse_m, errors.rotation_rmse_deg, errors.velocity_rmse_mps);
-        j["rotor_error_rpm"] = {errors.rotor_error_rpm[0], errors.rotor_error_rpm[1], errors.rotor_error_rpm[2],
-                                errors.rotor_error_rpm[3]};
-        j["rotor_error_percent"] = {errors.rotor_error_percent[0], errors.rotor_error_percent[1],
-                                    errors.rotor_error_percent[2], errors.rotor_error_percent[3]};
-        j["position_rmse_m"] = errors.position_rmse_m;
-        j["rotation_rmse_deg"] = errors.rotation_rmse_deg;
-        j["velocity_rmse_mps"] = errors.velocity_rmse_mps;
+                   errors->position_rmse_m, errors->rotation_rmse_deg, errors->velocity_rmse_mps);
       } else {
         fmt::print("(no truth.csv: no errors)\n");
       }
       if (!e.converged) fmt::print(stderr, "cheval: warning: the solver did not converge: {}\n", e.solver_report);
-      if (!flags->json.empty()) traj::WriteFileAtomically(flags->json, j.dump(2) + "\n");
+      // Both outputs are formatted before either is written.
+      const std::string json = sim::QuadrotorEstimateJson(e, errors ? &*errors : nullptr);
+      const std::string states = flags->states_output.empty() ? "" : sim::QuadrotorStatesCsv(sim::EstimatedStates(e));
+      if (!flags->states_output.empty()) traj::WriteFileAtomically(flags->states_output, states);
+      if (!flags->json.empty()) traj::WriteFileAtomically(flags->json, json);
     };
   });
 }

@@ -92,6 +92,24 @@ QuadrotorData SimulateQuadrotor(const estim::Vehicle& vehicle, const QuadrotorSi
 std::optional<Eigen::Vector2d> Project(const estim::PinholeCamera& camera, const Eigen::Vector3d& p,
                                        const Eigen::Matrix3d& R, const Eigen::Vector3d& x);
 
+/// The times an estimate of `data` is reported at: the truth's times when the data has a truth (so
+/// CompareWithTruth can use them), else every 10 ms from the first front-end pose to the last.
+std::vector<double> ReportTimes(const QuadrotorData& data);
+
+/// The states of an estimate in the layout of QuadrotorTruth (its samples, in time order).
+std::vector<QuadrotorTruth> EstimatedStates(const estim::QuadrotorEstimate& estimate);
+
+/// The CSV text of states as truth.csv holds them (docs/estimator.md): header
+/// `t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,rotor0,rotor1,rotor2,rotor3`, numbers with 17
+/// significant digits. `cheval estimate quadrotor -o FILE` writes an estimate this way.
+std::string QuadrotorStatesCsv(const std::vector<QuadrotorTruth>& states);
+
+/// The JSON object of `cheval estimate quadrotor --json` (docs/estimator.md): states, segments,
+/// degree, iterations, seconds, converged and, when `errors` is given, rotor_error_rpm,
+/// rotor_error_percent (4 numbers each), position_rmse_m, rotation_rmse_deg, velocity_rmse_mps.
+/// The Python module returns the same object as a dict.
+std::string QuadrotorEstimateJson(const estim::QuadrotorEstimate& estimate, const QuadrotorErrors* errors);
+
 /// Writes a data folder (docs/estimator.md): vehicle.json, landmarks.csv, measurements.csv,
 /// initial.csv and truth.csv. Creates the folder. OutputError when a file cannot be written.
 void WriteQuadrotorData(const QuadrotorData& data, const std::string& folder);
