@@ -197,7 +197,21 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
     i = j;
   }
 
+  // Progress after every iteration of every solve (the pilot's and the final one's).
+  class IterationProgress : public ceres::IterationCallback {
+   public:
+    explicit IterationProgress(const ProgressFn& progress) : progress_(progress) {}
+    ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+      if (summary.iteration > 0) ReportProgress(progress_, "solver iterations", ++done_, 0);
+      return ceres::SOLVER_CONTINUE;
+    }
+
+   private:
+    const ProgressFn& progress_;
+    int64_t done_ = 0;
+  } iteration_progress(options.progress);
   ceres::Solver::Options solver;
+  if (options.progress) solver.callbacks.push_back(&iteration_progress);
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   solver.max_num_iterations = options.max_iterations;
   solver.num_threads = options.threads;

@@ -92,6 +92,11 @@ TEST_F(CliTest, ProgressOnlyOnATerminalAndNeverWithQuiet) {
   ASSERT_EQ(tty.exit_code, 0) << tty.err;
   EXPECT_NE(tty.out.find("fitting"), std::string::npos) << tty.out;
   EXPECT_NE(tty.out.find("\r\x1b[K"), std::string::npos) << "the bar is erased at the end";
+  // The estimator counts its solver iterations.
+  RunResult estimate = Shell("script -qec '" + std::string(CHEVAL_EXE) +
+                             " estimate quadrotor --scenario hover --duration 2' /dev/null");
+  ASSERT_EQ(estimate.exit_code, 0) << estimate.err;
+  EXPECT_NE(estimate.out.find("\rsolver iterations (1)"), std::string::npos) << estimate.out;
   RunResult tty_quiet = Shell("script -qec '" + command + " --quiet' /dev/null");
   ASSERT_EQ(tty_quiet.exit_code, 0) << tty_quiet.err;
   std::string without_line_ends = tty_quiet.out;  // a pty turns "\n" into "\r\n"

@@ -117,8 +117,11 @@ void RegisterEstimate(CLI::App& app, Action* action) {
         data = sim::SimulateQuadrotor(estim::ReadVehicle(flags->vehicle), SimOptions(*flags));
       }
       const std::vector<double> times = sim::ReportTimes(data);  // the truth's, else every 10 ms
+      estim::QuadrotorEstimateOptions options = flags->options;
+      options.progress = Progress().Fn();  // on a terminal only
       const estim::QuadrotorEstimate e =
-          estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, flags->options, times);
+          estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, options, times);
+      Progress().Clear();  // the iteration count has no end of its own
       fmt::print("states              {}\nsegments            {}\ndegree              {}\n", e.states, e.segments,
                  e.degree);
       fmt::print("solver iterations   {}{}\nseconds             {:.3f}\n", e.iterations,

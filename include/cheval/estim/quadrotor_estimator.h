@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "cheval/common/progress.h"
 #include "cheval/estim/vehicle.h"
 
 namespace cheval::estim {
@@ -59,6 +60,8 @@ struct QuadrotorEstimateOptions {
   double initial_trust_region_radius = 1e8;
   int max_iterations = 50;
   int threads = 1;
+  /// Told "solver iterations" with the iterations done so far (total unknown: 0), after each one.
+  ProgressFn progress;
 };
 
 /// The estimate at one time.
