@@ -11,6 +11,10 @@ packages=(
   chromium chromium-driver  # the browser test of `cheval report` (tests/report/browser_test.js)
 )
 
+# The report's chart library comes from the npm registry at build time: the machine's Node.js and npm
+# are used when present; otherwise Debian's.
+if ! command -v npm >/dev/null 2>&1; then packages+=(nodejs npm); fi
+
 missing=()
 for p in "${packages[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
