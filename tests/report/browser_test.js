@@ -134,6 +134,20 @@ async function main() {
     const size = fs.statSync(screenshot).size;
     check(size > 50000, `screenshot ${screenshot} written (${size} bytes)`);
     fs.copyFileSync(page, path.join(outputDir, 'report.html'));
+
+    // The report of the README's demo data (scripts/demo.sh, steps 1 and 4) renders with every chart.
+    run('sim', 'motion', '--kind', 'drone', '--seed', '7', '--noise', '0.0005', '--rotation-noise', '0.003', '--duration', '60',
+      '--rate', '200', '-o', 'demo_mocap.txt', '--estimate', 'demo_vio_a.txt', '--estimate', 'demo_vio_b.txt',
+      '--estimate-drift', '0.001', '0.004', '--quiet');
+    run('report', 'demo_mocap.txt', 'demo_vio_a.txt', 'demo_vio_b.txt', '-o', 'demo_report.html');
+    problems.length = 0;
+    await tab.goto('file://' + path.join(work, 'demo_report.html'));
+    await tab.waitForSelector('body[data-ready], body[data-error]', { timeout: 30000 });
+    check(await tab.getAttribute('body', 'data-error') === null, 'the demo report\'s script ran without an exception');
+    check(problems.length === 0, `the demo report: no console error or warning, no request${problems.length ? ': ' + problems.join('; ') : ''}`);
+    const demoCharts = await tab.$$eval('.chart', (boxes) => boxes.map((b) => ({ id: b.dataset.chart, points: Number(b.dataset.points || 0) })));
+    check(JSON.stringify(demoCharts.map((c) => c.id)) === JSON.stringify(expected), `the demo report has every chart (${demoCharts.map((c) => c.id).join(', ')})`);
+    for (const c of demoCharts) check(c.points > 0, `demo report: chart ${c.id} has data (${c.points} points)`);
   } finally {
     await context.close();
   }
