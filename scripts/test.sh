@@ -10,7 +10,10 @@ build_dir=build
 cmake_args=(-DCMAKE_BUILD_TYPE=Release -DCHEVAL_BUILD_TESTS=ON -DCHEVAL_BUILD_BENCH=ON -DCHEVAL_BUILD_PYTHON=ON)
 if [ "${1:-}" = "--sanitize" ]; then
   build_dir=build-asan
-  cmake_args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DCHEVAL_BUILD_TESTS=ON -DCHEVAL_BUILD_BENCH=OFF -DCHEVAL_SANITIZE=ON
+  # -O1 -g1 (line tables for the sanitizers' stack traces): the heaviest file (the estimator, Ceres
+  # templates) compiles in 62 s instead of 193 s at -O2 -g, which is most of CI's sanitizer run.
+  cmake_args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG"
+              -DCHEVAL_BUILD_TESTS=ON -DCHEVAL_BUILD_BENCH=OFF -DCHEVAL_SANITIZE=ON
               -DCHEVAL_BUILD_PYTHON=OFF)  # Python cannot load an instrumented module without preloading the runtime
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
