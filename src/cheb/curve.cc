@@ -472,9 +472,10 @@ std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::Ve
     std::optional<CurveWindow> window = fitter.Fit(a, b, segment.begin, segment.end, may_split);
     if (window) {
       windows.push_back(std::move(*window));
-      // Progress: the samples up to this window's end are fitted (windows come in time order).
-      const auto done = std::upper_bound(t.data(), t.data() + t.size(), b) - t.data();
-      ReportProgress(options.progress, "fitting windows", done, t.size());
+      if (options.progress) {  // the samples up to this window's end are fitted (windows come in time order)
+        const auto done = std::upper_bound(t.data(), t.data() + t.size(), b) - t.data();
+        options.progress("fitting windows", done, t.size());
+      }
     } else {
       const double middle = 0.5 * (a + b);
       stack.emplace_back(middle, b);  // the left half is popped first: windows stay in time order

@@ -4,6 +4,8 @@
 #include <cstring>
 #include <filesystem>
 #include <random>
+#include <span>
+#include <vector>
 
 #include <unistd.h>
 
@@ -108,7 +110,11 @@ std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
   return out;
 }
 
-void WriteFileAtomically(const std::string& path, std::string_view text) {
+namespace {
+
+// Writes `text` to a new temporary file beside `path`, flushed to disk; returns its path. Throws
+// OutputError naming `path` (and leaves no temporary) when it cannot.
+std::filesystem::path StageFile(const std::string& path, std::string_view text) {
   namespace fs = std::filesystem;
   const fs::path target(path);
   const fs::path directory = target.has_parent_path() ? target.parent_path() : fs::path(".");
@@ -128,13 +134,39 @@ void WriteFileAtomically(const std::string& path, std::string_view text) {
     fs::remove(temporary, ignored);
     throw OutputError(fmt::format("{}: error: cannot write: {}", path, std::strerror(saved_errno)));
   }
-  std::error_code error;
-  fs::rename(temporary, target, error);
-  if (error) {
-    std::error_code ignored;
-    fs::remove(temporary, ignored);
-    throw OutputError(fmt::format("{}: error: cannot write: {}", path, error.message()));
+  return temporary;
+}
+
+}  // namespace
+
+void WriteFilesAtomically(std::span<const FileToWrite> files) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> staged;
+  auto remove_staged = [&staged](size_t from) {
+    for (size_t k = from; k < staged.size(); ++k) {
+      std::error_code ignored;
+      fs::remove(staged[k], ignored);
+    }
+  };
+  try {
+    for (const FileToWrite& file : files) staged.push_back(StageFile(file.path, file.text));
+  } catch (...) {
+    remove_staged(0);  // nothing was replaced yet
+    throw;
   }
+  for (size_t k = 0; k < staged.size(); ++k) {
+    std::error_code error;
+    fs::rename(staged[k], files[k].path, error);
+    if (error) {
+      remove_staged(k);
+      throw OutputError(fmt::format("{}: error: cannot write: {}", files[k].path, error.message()));
+    }
+  }
+}
+
+void WriteFileAtomically(const std::string& path, std::string_view text) {
+  const FileToWrite file{path, text};
+  WriteFilesAtomically(std::span<const FileToWrite>(&file, 1));
 }
 
 void WriteTrajectory(const std::string& path, const TrajectoryView& trajectory, Format format) {

@@ -4,6 +4,8 @@
 #include <optional>
 
 #include <fmt/format.h>
+
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "cheval/cheb/compress.h"
@@ -85,8 +87,10 @@ void RegisterCompress(CLI::App& app, Action* action) {
       const std::string text = cheb::WriteModelJson(result.model);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       const nlohmann::json report = Report(*flags, view, result, text.size(), seconds);
-      traj::WriteFileAtomically(flags->output, text);
-      if (!flags->json_path.empty()) traj::WriteFileAtomically(flags->json_path, report.dump(2) + "\n");
+      const std::string report_text = report.dump(2) + "\n";
+      std::vector<traj::FileToWrite> files{{flags->output, text}};
+      if (!flags->json_path.empty()) files.push_back({flags->json_path, report_text});
+      traj::WriteFilesAtomically(files);
       const auto windows = report["windows"].get<size_t>();
       fmt::print(
           "{}: {} poses -> {}: {} window{} in {} segment{}, {} numbers for {} positions: compression {:.1f}x; "

@@ -1,6 +1,8 @@
 // `cheval convert IN -o OUT [--to tum|tumv|euroc|kitti]`: rewrite a trajectory in another format.
 #include <fmt/format.h>
 
+#include <vector>
+
 #include "cheval/common/error.h"
 #include "cheval/traj/stamp.h"
 #include "common.h"
@@ -50,8 +52,9 @@ void RegisterConvert(CLI::App& app, Action* action) {
         if (!trajectory.channels().has_stamps) throw ComputeError("--times-output: the input has no stamps");
         for (int64_t stamp : trajectory.stamps_ns()) times += traj::FormatSeconds(stamp) + "\n";
       }
-      traj::WriteFileAtomically(flags->output, text);
-      if (!times.empty()) traj::WriteFileAtomically(flags->times_output, times);
+      std::vector<traj::FileToWrite> files{{flags->output, text}};
+      if (!times.empty()) files.push_back({flags->times_output, times});
+      traj::WriteFilesAtomically(files);
       if (!Quiet()) fmt::print(stderr, "wrote {} poses to {} ({})\n", trajectory.size(), flags->output, traj::ToString(to));
     };
   });

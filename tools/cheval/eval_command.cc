@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include <vector>
+
 #include "cheval/common/error.h"
 #include "progress.h"
 #include "cheval/traj/stamp.h"
@@ -192,8 +194,10 @@ void Run(CLI::App* command, eval::MetricKind metric, const EvalFlags& flags) {
 
   for (const Evaluated& e : all) PrintResult(flags, e, ref.size());
   if (all.size() > 1) PrintComparison(all);
-  if (!flags.json_path.empty()) traj::WriteFileAtomically(flags.json_path, json_text);
-  if (!flags.errors_path.empty()) traj::WriteFileAtomically(flags.errors_path, errors_text);
+  std::vector<traj::FileToWrite> files;
+  if (!flags.json_path.empty()) files.push_back({flags.json_path, json_text});
+  if (!flags.errors_path.empty()) files.push_back({flags.errors_path, errors_text});
+  traj::WriteFilesAtomically(files);
 }
 
 }  // namespace

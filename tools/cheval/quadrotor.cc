@@ -7,6 +7,7 @@
 #include <fstream>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "cheval/common/error.h"
 #include "cheval/estim/quadrotor_estimator.h"
@@ -142,8 +143,10 @@ void RegisterEstimate(CLI::App& app, Action* action) {
       // Both outputs are formatted before either is written.
       const std::string json = sim::QuadrotorEstimateJson(e, errors ? &*errors : nullptr);
       const std::string states = flags->states_output.empty() ? "" : sim::QuadrotorStatesCsv(sim::EstimatedStates(e));
-      if (!flags->states_output.empty()) traj::WriteFileAtomically(flags->states_output, states);
-      if (!flags->json.empty()) traj::WriteFileAtomically(flags->json, json);
+      std::vector<traj::FileToWrite> files;
+      if (!flags->states_output.empty()) files.push_back({flags->states_output, states});
+      if (!flags->json.empty()) files.push_back({flags->json, json});
+      traj::WriteFilesAtomically(files);
     };
   });
 }

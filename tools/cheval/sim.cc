@@ -2,7 +2,6 @@
 // (noise, jittered stamps, dropouts, gaps). See docs/sim.md.
 #include <fmt/format.h>
 
-#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,22 +26,6 @@ struct SimMotionFlags {
   sim::EstimatorSimOptions estimator;
   std::vector<double> estimate_drifts;  // --estimate-drift: one value for all, or one per estimate
 };
-
-// Writes every (path, text) atomically; if one cannot be written, those already written are removed
-// again, so a failure leaves none of them behind.
-void WriteAllOrNone(const std::vector<std::pair<std::string, std::string>>& files) {
-  for (size_t i = 0; i < files.size(); ++i) {
-    try {
-      traj::WriteFileAtomically(files[i].first, files[i].second);
-    } catch (...) {
-      for (size_t k = 0; k < i; ++k) {
-        std::error_code ignored;
-        std::filesystem::remove(files[k].first, ignored);
-      }
-      throw;
-    }
-  }
-}
 
 }  // namespace
 
@@ -106,10 +89,10 @@ void RegisterSim(CLI::App& app, Action* action) {
       const traj::Trajectory measured = sim::Measure(model, flags->measurement);
       const traj::Trajectory truth = sim::GenerateMotion(model);
       // Everything is formatted before anything is written.
-      std::vector<std::pair<std::string, std::string>> files;
-      files.emplace_back(flags->output, traj::FormatTrajectory(measured.View(), traj::Format::kTum));
+      std::vector<std::pair<std::string, std::string>> outputs;  // (path, text), written all at once or none
+      outputs.emplace_back(flags->output, traj::FormatTrajectory(measured.View(), traj::Format::kTum));
       if (!flags->truth_output.empty()) {
-        files.emplace_back(flags->truth_output, traj::FormatTrajectory(truth.View(), traj::Format::kTumV));
+        outputs.emplace_back(flags->truth_output, traj::FormatTrajectory(truth.View(), traj::Format::kTumV));
       }
       for (size_t k = 0; k < n_estimates; ++k) {
         sim::EstimatorSimOptions estimator = flags->estimator;
@@ -118,9 +101,11 @@ void RegisterSim(CLI::App& app, Action* action) {
           estimator.velocity_random_walk = flags->estimate_drifts[flags->estimate_drifts.size() == 1 ? 0 : k];
         }
         const traj::Trajectory estimate = sim::SimulateEstimate(model, estimator);
-        files.emplace_back(flags->estimate_outputs[k], traj::FormatTrajectory(estimate.View(), traj::Format::kTumV));
+        outputs.emplace_back(flags->estimate_outputs[k], traj::FormatTrajectory(estimate.View(), traj::Format::kTumV));
       }
-      WriteAllOrNone(files);
+      std::vector<traj::FileToWrite> files;
+      for (const auto& [path, text] : outputs) files.push_back({path, text});
+      traj::WriteFilesAtomically(files);
       const sim::MotionOptions& used = model.options();
       if (!Quiet()) fmt::print(stderr,
                  "wrote {} measured poses ({}, {} s at {} Hz, seed {}; noise {} m, jitter {} s, {} removed by dropouts "

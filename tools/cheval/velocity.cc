@@ -5,6 +5,8 @@
 #include <cstdio>
 
 #include <fmt/format.h>
+
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "cheval/common/error.h"
@@ -186,8 +188,11 @@ void RegisterVelocity(CLI::App& app, Action* action) {
         fmt::print(stderr, "cheval: warning: {} has no orientation; {} gets identity quaternions\n", flags->input,
                    flags->output);
       }
-      if (!flags->output.empty()) traj::WriteFileAtomically(flags->output, text);
-      if (!flags->json_path.empty()) traj::WriteFileAtomically(flags->json_path, j.dump(2) + "\n");
+      const std::string json_text = j.dump(2) + "\n";
+      std::vector<traj::FileToWrite> files;
+      if (!flags->output.empty()) files.push_back({flags->output, text});
+      if (!flags->json_path.empty()) files.push_back({flags->json_path, json_text});
+      traj::WriteFilesAtomically(files);
       if (estimate.curve) {
         fmt::print("{}: {} poses, {} windows in {} segments, degrees {}..{}, noise sigma {:.3g} m, residual RMSE "
                    "{:.3g} m, compression {:.1f}x, {:.3f} s\n",
