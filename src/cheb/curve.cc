@@ -1,5 +1,7 @@
 #include "cheval/cheb/curve.h"
 
+#include "end_caps.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -661,6 +663,17 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
       RefineEnds(fitter, t, segment, options);
     }
     curve.segments_.push_back(std::move(segment));
+  }
+
+  if (options.end_caps && !options.single_window && !options.window_s &&
+      options.degree_method != DegreeMethod::kFixed) {
+    std::vector<int64_t> sorted(static_cast<size_t>(m));
+    for (Eigen::Index i = 0; i < m; ++i) sorted[static_cast<size_t>(i)] = stamps_ns[order[i]];
+    Eigen::MatrixXd ignored, velocity;
+    curve.EvaluateMany(sorted, 1, &ignored, &velocity);
+    for (size_t k = 0; k + 1 < starts.size(); ++k) {
+      internal::AddEndCaps(t, z, velocity, starts[k], starts[k + 1], &curve.segments_[k]);
+    }
   }
 
   ReportProgress(options.progress, "fitting windows", m, m);

@@ -70,6 +70,12 @@ struct CurveOptions {
   /// default: over 15 simulator seeds it helped the legged kind (more seeds within Savitzky–Golay's
   /// error) but made other rows worse by up to ~25 % (docs/velocity.md, "Ends by velocity risk").
   bool end_velocity_risk = false;
+  /// Then give each end of a segment a short low-degree "cap" where that is estimated to lower the
+  /// velocity error: the cap's length, blending boundary and degrees are chosen by one-sided fits
+  /// at artificial ends inside the segment, checked against the curve's interior velocity there
+  /// (docs/velocity.md, "End caps"). Adaptive windows only (not with window_s, single_window or a
+  /// fixed degree, which ask for a literal fit); segments need at least three windows.
+  bool end_caps = true;
   /// Fit a single window over each gap-free segment (no splitting), e.g. to reproduce a global fit.
   bool single_window = false;
   /// Told "fitting windows" with the samples fitted so far, as windows are accepted (may be empty).

@@ -1,0 +1,315 @@
+#include "end_caps.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "cheval/cheb/chebyshev.h"
+#include "cheval/cheb/fit.h"
+#include "cheval/common/error.h"
+
+namespace cheval::cheb::internal {
+namespace {
+
+// Candidate caps: samples m from the end, degree p (at most m/4 - 1), and the blending boundary z
+// (in samples from the end: the cap alone up to z/2, blended into the end window up to 1.5 z).
+constexpr std::array<int, 9> kCapSamples{16, 23, 32, 45, 64, 91, 128, 181, 256};
+constexpr std::array<int, 8> kCapDegrees{1, 2, 3, 4, 5, 6, 8, 10};
+constexpr std::array<int, 11> kCapBoundaries{4, 6, 8, 11, 16, 23, 32, 45, 64, 91, 128};
+// Artificial ends per direction (pooled: 2 x 64 one-sided fits per candidate and end).
+constexpr int kArtificialEnds = 64;
+
+// Samples read from an end inward as if they were a segment's first ones: τ ≥ 0 (s from the end),
+// the values, and the reference velocity d/dτ (negated when read backwards in time).
+struct Block {
+  Eigen::VectorXd tau;
+  Eigen::MatrixXd z, v;
+};
+
+Block ReadBlock(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Eigen::MatrixXd& v, Eigen::Index start,
+                Eigen::Index count, bool backwards) {
+  Block block{Eigen::VectorXd(count), Eigen::MatrixXd(count, z.cols()), Eigen::MatrixXd(count, z.cols())};
+  for (Eigen::Index i = 0; i < count; ++i) {
+    const Eigen::Index k = backwards ? start - i : start + i;
+    block.tau[i] = backwards ? t[start] - t[k] : t[k] - t[start];
+    block.z.row(i) = z.row(k);
+    block.v.row(i) = backwards ? Eigen::RowVectorXd(-v.row(k)) : Eigen::RowVectorXd(v.row(k));
+  }
+  return block;
+}
+
+// The least-squares fits of every degree up to `top` to a block's first m samples (one Cholesky),
+// and their velocities at the block's first `count` samples.
+class OneSidedFits {
+ public:
+  OneSidedFits(const Block& block, Eigen::Index m, int top, Eigen::Index count)
+      : normal_(SmallNormalEquations(block, m, top)), cholesky_(normal_, top), derivative_basis_(count, top + 1) {
+    // d/dτ T_k(x(τ)) = k U_{k-1}(x) · dx/dτ, U the Chebyshev polynomials of the second kind.
+    const Interval interval{0.0, block.tau[m - 1]};
+    const double scale = interval.DerivativeScale();
+    for (Eigen::Index j = 0; j < count; ++j) {
+      const double x = interval.ToUnit(block.tau[j]);
+      double u_previous = 0.0, u = 1.0;  // U_{k-2}, U_{k-1}
+      derivative_basis_(j, 0) = 0.0;
+      for (int k = 1; k <= top; ++k) {
+        derivative_basis_(j, k) = k * u * scale;
+        const double next = 2.0 * x * u - u_previous;
+        u_previous = u;
+        u = next;
+      }
+    }
+  }
+
+  // Velocities at the first `count` samples; coordinate c from the fit of degree degrees[c].
+  Eigen::MatrixXd Velocity(const std::vector<int>& degrees, Eigen::Index count) const {
+    Eigen::MatrixXd out(count, static_cast<Eigen::Index>(degrees.size()));
+    for (Eigen::Index c = 0; c < out.cols(); ++c) {
+      const int n = degrees[c] + 1;
+      out.col(c).noalias() = derivative_basis_.topLeftCorner(count, n).lazyProduct(cholesky_.Solve(degrees[c], normal_.rhs.col(c)));
+    }
+    return out;
+  }
+  // The same with every coordinate at one degree.
+  Eigen::MatrixXd Velocity(int degree, Eigen::Index count) const {
+    return derivative_basis_.topLeftCorner(count, degree + 1).lazyProduct(cholesky_.Solve(degree, normal_.rhs));
+  }
+
+ private:
+  // The normal equations from Chebyshev moments, G_ij = (S_{i+j} + S_{|i-j|}) / 2 with
+  // S_n = Σ T_n(x_i) (fit.h), accumulated directly: for these short fits this beats
+  // BuildNormalEquations, whose vectorised accumulation is made for long windows.
+  static NormalEquations SmallNormalEquations(const Block& block, Eigen::Index m, int top) {
+    NormalEquations normal;
+    normal.interval = {0.0, block.tau[m - 1]};
+    normal.samples = m;
+    const Eigen::Index d = block.z.cols();
+    Eigen::VectorXd moments = Eigen::VectorXd::Zero(2 * top + 1), basis(2 * top + 1);
+    normal.rhs = Eigen::MatrixXd::Zero(top + 1, d);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      const double x = normal.interval.ToUnit(block.tau[i]);
+      basis[0] = 1.0;
+      if (top >= 1) basis[1] = x;
+      for (int k = 2; k <= 2 * top; ++k) basis[k] = 2.0 * x * basis[k - 1] - basis[k - 2];
+      moments += basis;
+      for (Eigen::Index c = 0; c < d; ++c) {
+        const double value = block.z(i, c);
+        for (int k = 0; k <= top; ++k) normal.rhs(k, c) += basis[k] * value;
+      }
+    }
+    normal.gram.resize(top + 1, top + 1);
+    for (int i = 0; i <= top; ++i) {
+      for (int j = 0; j <= top; ++j) normal.gram(i, j) = 0.5 * (moments[i + j] + moments[std::abs(i - j)]);
+    }
+    return normal;
+  }
+
+  NormalEquations normal_;
+  NestedCholesky cholesky_;
+  Eigen::MatrixXd derivative_basis_;  // count x (top + 1)
+};
+
+// Weight of the cap at offset j (samples from the end) for boundary z: the curve's blend,
+// 1 − s((j − z/2)/z) with s the quintic smoothstep (Curve::Locate with half-width z/2).
+double CapWeight(Eigen::Index j, int z) {
+  double s = 0, ds = 0, dds = 0;
+  Smoothstep((static_cast<double>(j) - 0.5 * z) / z, &s, &ds, &dds);
+  return 1.0 - s;
+}
+Eigen::Index BlendEnd(int z) { return static_cast<Eigen::Index>(std::ceil(1.5 * z)) + 1; }
+
+struct Candidate {
+  int samples = 0, degree = 0;
+  Eigen::Index offsets = 0;  // velocities compared at offsets 0..offsets-1
+  Eigen::MatrixXd a, b;      // pooled Σ Δ² and Σ Δ·e per offset and coordinate (Δ = cap − end, e = end − reference)
+};
+
+struct Choice {
+  double gain = 0;  // pooled change of the summed squared velocity error (< 0: the cap helps)
+  int samples = 0, boundary = 0;
+  std::vector<int> degrees;  // per coordinate; −1 keeps the end window's polynomial
+};
+
+// Chooses the cap of one end (front: the segment's start) from the artificial ends in [lo, hi).
+Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Eigen::MatrixXd& velocity, Eigen::Index lo,
+                 Eigen::Index hi, Eigen::Index segment_samples, const CurveWindow& end, Eigen::Index end_samples,
+                 Eigen::Index core_samples) {
+  const Eigen::Index d = z.cols(), room = hi - lo;
+  auto boundary_allowed = [&](int m, int boundary) {
+    return 1.5 * boundary <= m - 1 && 2 * boundary <= core_samples;
+  };
+  std::vector<Candidate> candidates;
+  Eigen::Index block_samples = end_samples, end_offsets = 0;
+  for (const int m : kCapSamples) {
+    if (m > room || 2 * m > segment_samples) break;
+    Eigen::Index offsets = 0;
+    for (const int boundary : kCapBoundaries) {
+      if (boundary_allowed(m, boundary)) offsets = BlendEnd(boundary);
+    }
+    if (offsets == 0) continue;
+    for (const int p : kCapDegrees) {
+      if (4 * (p + 1) > m) break;
+      candidates.push_back({m, p, offsets, Eigen::MatrixXd::Zero(offsets, d), Eigen::MatrixXd::Zero(offsets, d)});
+    }
+    block_samples = std::max<Eigen::Index>(block_samples, m);
+    end_offsets = std::max(end_offsets, offsets);
+  }
+  if (candidates.empty() || block_samples > room || end_offsets > end_samples) return {};
+
+  const int end_top = *std::max_element(end.degrees.begin(), end.degrees.end());
+  int pooled = 0;
+  for (const bool backwards : {false, true}) {
+    const Eigen::Index first = backwards ? lo + block_samples - 1 : lo, span = room - block_samples;
+    const Eigen::Index count = std::min<Eigen::Index>(kArtificialEnds, span + 1);
+    for (Eigen::Index k = 0; k < count; ++k) {
+      const Eigen::Index start = first + (count > 1 ? k * span / (count - 1) : 0);
+      const Block block = ReadBlock(t, z, velocity, start, block_samples, backwards);
+      try {
+        const Eigen::MatrixXd end_velocity = OneSidedFits(block, end_samples, end_top, end_offsets).Velocity(end.degrees, end_offsets);
+        const Eigen::MatrixXd end_error = end_velocity - block.v.topRows(end_offsets);
+        std::vector<Eigen::MatrixXd> deltas;
+        for (size_t i = 0; i < candidates.size();) {
+          const int m = candidates[i].samples;
+          size_t j = i;
+          while (j < candidates.size() && candidates[j].samples == m) ++j;
+          const OneSidedFits fits(block, m, candidates[j - 1].degree, candidates[i].offsets);
+          for (; i < j; ++i) {
+            const Eigen::Index n = candidates[i].offsets;
+            deltas.push_back(fits.Velocity(candidates[i].degree, n) - end_velocity.topRows(n));
+          }
+        }
+        for (size_t i = 0; i < candidates.size(); ++i) {
+          const Eigen::Index n = candidates[i].offsets;
+          candidates[i].a += deltas[i].cwiseAbs2();
+          candidates[i].b += deltas[i].cwiseProduct(end_error.topRows(n));
+        }
+        ++pooled;
+      } catch (const ComputeError&) {
+        // A singular one-sided fit (repeated stamps): this artificial end is left out for all.
+      }
+    }
+  }
+  if (pooled < 8) return {};
+
+  Choice best;
+  for (size_t i = 0; i < candidates.size();) {
+    const int m = candidates[i].samples;
+    size_t j = i;
+    while (j < candidates.size() && candidates[j].samples == m) ++j;
+    for (const int boundary : kCapBoundaries) {
+      if (!boundary_allowed(m, boundary)) continue;
+      const Eigen::Index n = BlendEnd(boundary);
+      Eigen::VectorXd w(n);
+      for (Eigen::Index o = 0; o < n; ++o) w[o] = CapWeight(o, boundary);
+      Choice choice{0.0, m, boundary, std::vector<int>(d, -1)};
+      for (Eigen::Index c = 0; c < d; ++c) {
+        double lowest = 0.0;  // keeping the end window's polynomial changes nothing
+        for (size_t k = i; k < j; ++k) {
+          const double gain = w.cwiseAbs2().dot(candidates[k].a.col(c).head(n)) +
+                              2.0 * w.dot(candidates[k].b.col(c).head(n));
+          if (gain < lowest) lowest = gain, choice.degrees[c] = candidates[k].degree;
+        }
+        choice.gain += lowest;
+      }
+      if (choice.gain < best.gain) best = std::move(choice);
+    }
+    i = j;
+  }
+  return best;
+}
+
+// The cap window of a choice over samples [begin, begin + m) of the segment.
+CurveWindow BuildCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index begin, const Choice& choice,
+                     const CurveWindow& end) {
+  const Eigen::Index m = choice.samples, d = z.cols();
+  CurveWindow cap;
+  cap.fit_begin = t[begin];
+  cap.fit_end = t[begin + m - 1];
+  cap.samples = m;
+  cap.series.interval = {cap.fit_begin, cap.fit_end};
+  const int top = *std::max_element(choice.degrees.begin(), choice.degrees.end());
+  std::vector<Eigen::VectorXd> columns(d);
+  if (top >= 0) {
+    const NormalEquations normal =
+        BuildNormalEquations(t.segment(begin, m), z.middleRows(begin, m), top, cap.series.interval);
+    const NestedCholesky cholesky(normal, top);
+    for (Eigen::Index c = 0; c < d; ++c) {
+      if (choice.degrees[c] >= 0) columns[c] = cholesky.Solve(choice.degrees[c], normal.rhs.col(c));
+    }
+  }
+  for (Eigen::Index c = 0; c < d; ++c) {
+    if (choice.degrees[c] >= 0) {
+      cap.degrees.push_back(choice.degrees[c]);
+      continue;
+    }
+    // The end window's own polynomial, re-expanded exactly on the cap's interval.
+    const int n = end.degrees[c];
+    cap.degrees.push_back(n);
+    if (n == 0) {
+      columns[c] = end.series.coefficients.block(0, c, 1, 1);
+      continue;
+    }
+    const Eigen::VectorXd points = ChebyshevPoints(n, cap.series.interval);
+    Eigen::MatrixXd values(n + 1, 1);
+    for (int k = 0; k <= n; ++k) {
+      values(k, 0) = Clenshaw(end.series.coefficients.col(c).head(n + 1), end.series.interval.ToUnit(points[k]))[0];
+    }
+    columns[c] = ValuesToCoefficients(values);
+  }
+  const int rows = *std::max_element(cap.degrees.begin(), cap.degrees.end()) + 1;
+  cap.series.coefficients = Eigen::MatrixXd::Zero(rows, d);
+  for (Eigen::Index c = 0; c < d; ++c) cap.series.coefficients.col(c).head(columns[c].size()) = columns[c];
+  cap.coefficient_magnitudes = cap.series.coefficients.cwiseAbs();
+  cap.first_derivative = DerivativeCoefficients(cap.series.coefficients);
+  cap.second_derivative = DerivativeCoefficients(cap.first_derivative);
+  return cap;
+}
+
+}  // namespace
+
+void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Eigen::MatrixXd& velocity,
+                Eigen::Index first, Eigen::Index last, CurveSegment* segment) {
+  std::vector<CurveWindow>& windows = segment->windows;
+  if (windows.size() < 3) return;
+  const double* begin = t.data() + first;
+  const double* end = t.data() + last;
+  auto samples_in = [&](double a, double b) { return std::upper_bound(begin, end, b) - std::lower_bound(begin, end, a); };
+  // Artificial ends lie where the curve's velocity is an interior one: off both end windows.
+  const Eigen::Index lo = std::upper_bound(begin, end, windows.front().fit_end) - t.data();
+  const Eigen::Index hi = std::lower_bound(begin, end, windows.back().fit_begin) - t.data();
+  if (hi <= lo) return;
+  std::array<Choice, 2> choices;
+  for (const bool front : {true, false}) {
+    const CurveWindow& w = front ? windows.front() : windows.back();
+    const Eigen::Index end_samples = samples_in(w.fit_begin, w.fit_end);
+    const Eigen::Index core_samples = samples_in(w.core_begin, w.core_end);
+    choices[front ? 0 : 1] = ChooseCap(t, z, velocity, lo, hi, last - first, w, end_samples, core_samples);
+  }
+  // The back first, so that inserting at the front leaves nothing to re-find.
+  if (choices[1].samples > 0) {
+    const Choice& c = choices[1];
+    CurveWindow& w = windows.back();
+    const double boundary = t[last - 1 - c.boundary];
+    if (boundary > w.core_begin && boundary < w.core_end) {
+      CurveWindow cap = BuildCap(t, z, last - c.samples, c, w);
+      cap.core_begin = boundary;
+      cap.core_end = w.core_end;
+      w.core_end = boundary;
+      windows.push_back(std::move(cap));
+    }
+  }
+  if (choices[0].samples > 0) {
+    const Choice& c = choices[0];
+    CurveWindow& w = windows.front();
+    const double boundary = t[first + c.boundary];
+    if (boundary > w.core_begin && boundary < w.core_end) {
+      CurveWindow cap = BuildCap(t, z, first, c, w);
+      cap.core_begin = w.core_begin;
+      cap.core_end = boundary;
+      w.core_begin = boundary;
+      windows.insert(windows.begin(), std::move(cap));
+    }
+  }
+}
+
+}  // namespace cheval::cheb::internal
