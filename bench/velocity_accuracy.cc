@@ -6,8 +6,9 @@
 // the best window of a grid (an oracle choice: it is told the truth), and one global Chebyshev fit
 // of fixed degree 400 (the C-ASE paper's choice for CARLA). Ratios are against the baseline
 // measured in the same run. A second table: body angular velocity from noisy orientations.
-//   build/bench/velocity_accuracy [DATA_DIR [SEEDS [FIRST_SEED [END_RISK]]]]
-// END_RISK = 1 turns on CurveOptions::end_velocity_risk for every Chebyshev column.
+//   build/bench/velocity_accuracy [DATA_DIR [SEEDS [FIRST_SEED [END_RISK [END_CAPS]]]]]
+// END_RISK = 1 turns on CurveOptions::end_velocity_risk for every Chebyshev column; END_CAPS = 0
+// turns off CurveOptions::end_caps (the figures before the end caps).
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -37,12 +38,14 @@ struct Row {
 };
 
 bool end_velocity_risk = false;  // END_RISK
+bool end_caps = true;            // END_CAPS
 
 Row Evaluate(const std::string& name, const traj::TrajectoryView& measured, const Eigen::Matrix3Xd& truth) {
   Row row;
   row.name = name;
   eval::VelocityOptions options;
   options.curve.end_velocity_risk = end_velocity_risk;
+  options.curve.end_caps = end_caps;
   const auto start = std::chrono::steady_clock::now();
   const eval::VelocityEstimate cheb = eval::EstimateVelocity(measured, options);
   row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -104,6 +107,7 @@ void AngularTable() {
       eval::VelocityOptions velocity;
       velocity.angular = true;
       velocity.curve.end_velocity_risk = end_velocity_risk;
+      velocity.curve.end_caps = end_caps;
       const auto start = std::chrono::steady_clock::now();
       const eval::VelocityEstimate cheb = eval::EstimateVelocity(measured.View(), velocity);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -129,6 +133,7 @@ int main(int argc, char** argv) {
   // Optional: the first seed (default 1), to test on seeds the tables of docs/velocity.md do not use.
   const uint64_t first_seed = argc > 3 ? std::stoull(argv[3]) : 1;
   end_velocity_risk = argc > 4 && std::string(argv[4]) == "1";
+  end_caps = !(argc > 5 && std::string(argv[5]) == "0");
   std::printf("velocity RMSE in mm/s, full range unless marked inner (middle 90 %%)\n\n");
   std::printf("| %-28s | %10s | %10s | %10s | %10s | %10s | %16s | %10s | %6s | %6s | %6s |\n", "trajectory",
               "cheval (cv)", "inner", "chop", "threshold", "central", "SG best (win)", "global 400", "/cent", "/SG", "s");

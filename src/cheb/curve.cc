@@ -669,8 +669,14 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
       options.degree_method != DegreeMethod::kFixed) {
     std::vector<int64_t> sorted(static_cast<size_t>(m));
     for (Eigen::Index i = 0; i < m; ++i) sorted[static_cast<size_t>(i)] = stamps_ns[order[i]];
-    Eigen::MatrixXd ignored, velocity;
-    curve.EvaluateMany(sorted, 1, &ignored, &velocity);
+    // A segment's caps are chosen before they are inserted, and evaluating one segment's samples
+    // uses only its own windows.
+    const internal::VelocityAt velocity = [&](Eigen::Index first, Eigen::Index count) {
+      Eigen::MatrixXd ignored, derivative;
+      curve.EvaluateMany(std::span<const int64_t>(sorted).subspan(static_cast<size_t>(first), static_cast<size_t>(count)),
+                         1, &ignored, &derivative);
+      return derivative;
+    };
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
       internal::AddEndCaps(t, z, velocity, starts[k], starts[k + 1], &curve.segments_[k]);
     }

@@ -1,11 +1,16 @@
 #pragma once
 // Internal to the cheb library: the end caps of a fitted curve segment (src/cheb/end_caps.cc).
 
+#include <functional>
+
 #include <Eigen/Core>
 
 #include "cheval/cheb/curve.h"
 
 namespace cheval::cheb::internal {
+
+/// The fitted curve's velocity (count x d) at the sorted samples first .. first + count - 1.
+using VelocityAt = std::function<Eigen::MatrixXd(Eigen::Index first, Eigen::Index count)>;
 
 /// Replaces the velocity of a segment's fit near its two ends by short, low-degree "caps" where
 /// that is estimated to lower the velocity error (docs/velocity.md, "End caps").
@@ -14,19 +19,19 @@ namespace cheval::cheb::internal {
 /// grows like N⁴/m there), and nothing inside one end window can tell how much worse: the data
 /// beyond the end are missing. So the choice is made where the answer can be checked: at many
 /// artificial ends inside the segment. Each candidate cap (m samples, degree p) and the segment's
-/// own end-window configuration are fitted one-sidedly at ~64 positions in each direction inside
+/// own end-window configuration are fitted one-sidedly at 32 positions in each direction inside
 /// the segment's interior, and their velocities are compared with the curve's interior velocity
 /// there (whose error is several times smaller than any one-sided fit's). The pooled squared
-/// errors, with the same C² blend the curve applies, pick the cap length, the blending boundary
-/// and a degree per coordinate; a coordinate for which no cap is estimated to help keeps the end
+/// errors, with the same C² blend the curve applies, pick the cap length, the blending boundary and
+/// a degree per coordinate; a coordinate for which no cap is estimated to help keeps the end
 /// window's own polynomial inside the cap. A cap is added only when it lowers the pooled error.
 ///
-/// `t` (sorted, s) and `z` (m x d) are the curve's samples, `velocity` (m x d) the fitted curve's
-/// velocity at them, [first, last) the segment's samples. The cap becomes the segment's first (or
-/// last) window; the neighbouring end window's core is shortened to make room. Segments too short
-/// for artificial ends (fewer than three windows, or an interior shorter than the windows) are left
-/// as they are.
-void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Eigen::MatrixXd& velocity,
-                Eigen::Index first, Eigen::Index last, CurveSegment* segment);
+/// `t` (sorted, s) and `z` (m x d) are the curve's samples, `velocity` gives the fitted curve's
+/// velocity at them (asked only where the artificial ends need it), [first, last) the segment's
+/// samples. The cap becomes the segment's first (or last) window; the neighbouring end window's
+/// core is shortened to make room. Segments too short for artificial ends (fewer than three
+/// windows, or an interior shorter than the windows) are left as they are.
+void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const VelocityAt& velocity, Eigen::Index first,
+                Eigen::Index last, CurveSegment* segment);
 
 }  // namespace cheval::cheb::internal

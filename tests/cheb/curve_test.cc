@@ -277,6 +277,67 @@ TEST(FitCurve, EndCapsImproveTheEnds) {
   EXPECT_LT(e.RmseFull(true), 0.85 * e.RmseFull(false)) << e.RmseFull(true) << " vs " << e.RmseFull(false);
 }
 
+TEST(FitCurve, EndCapsAreWindowsThatTileTheSegmentAndJoinSmoothly) {
+  const Samples s = Sample(10.0, 200.0, 1e-3, 21);
+  CurveOptions without;
+  without.end_caps = false;
+  const Curve plain = FitCurve(s.stamps, s.values, without);
+  const Curve capped = FitCurve(s.stamps, s.values);
+  ASSERT_EQ(capped.segments().size(), 1u);
+  const auto& windows = capped.segments()[0].windows;
+  const auto& plain_windows = plain.segments()[0].windows;
+  ASSERT_GE(windows.size(), plain_windows.size());
+  ASSERT_LE(windows.size(), plain_windows.size() + 2);
+  // The caps are short windows at the ends, inside what the end windows covered; the interior
+  // windows are the same.
+  const bool front = windows.front().core_end < plain_windows.front().core_end;
+  const bool back = windows.back().core_begin > plain_windows.back().core_begin;
+  EXPECT_EQ(windows.size(), plain_windows.size() + (front ? 1 : 0) + (back ? 1 : 0));
+  EXPECT_TRUE(front || back) << "this noisy recording is expected to get at least one cap";
+  for (size_t k = 0; k < windows.size(); ++k) {
+    if (k > 0) EXPECT_EQ(windows[k].core_begin, windows[k - 1].core_end);
+    EXPECT_LT(windows[k].core_begin, windows[k].core_end);
+    EXPECT_LE(windows[k].fit_begin, windows[k].core_begin);
+    EXPECT_GE(windows[k].fit_end, windows[k].core_end);
+  }
+  EXPECT_EQ(windows.front().core_begin, plain_windows.front().core_begin);
+  EXPECT_EQ(windows.back().core_end, plain_windows.back().core_end);
+  // Rebuilt from its parts (as a stored model is), the curve evaluates identically.
+  const Curve rebuilt = Curve::FromParts(capped.origin_ns(), capped.segments(), capped.noise_sigma(),
+                                         capped.residual_rms());
+  // Velocity is continuous across each cap's blend: steps of 1 µs change it by no more than the
+  // acceleration allows.
+  Eigen::VectorXd p(3), v(3), a(3), p2(3), v2(3), a2(3);
+  const int64_t begin = s.stamps.front(), end = s.stamps.back();
+  for (int64_t t = begin; t + 1000 <= begin + 500'000'000; t += 1000) {
+    capped.Evaluate(t, p, v, a);
+    capped.Evaluate(t + 1000, p2, v2, a2);
+    EXPECT_LT((v2 - v).norm(), 1e-6 * (a.norm() + a2.norm()) + 1e-9) << "at " << (t - begin) * 1e-9 << " s";
+    rebuilt.Evaluate(t, p2, v2, a2);
+    EXPECT_EQ(v, v2);
+  }
+  for (int64_t t = end - 500'000'000; t + 1000 <= end; t += 1000) {
+    capped.Evaluate(t, p, v, a);
+    capped.Evaluate(t + 1000, p2, v2, a2);
+    EXPECT_LT((v2 - v).norm(), 1e-6 * (a.norm() + a2.norm()) + 1e-9) << "at " << (t - begin) * 1e-9 << " s";
+  }
+}
+
+TEST(FitCurve, EndCapsKeepNoiseFreeFitsExactAndSkipShortRecordings) {
+  // Noise-free: whatever cap is chosen must not spoil a spectrally accurate fit.
+  const Samples exact = Sample(10.0, 200.0, 0.0, 1);
+  EXPECT_LT(VelocityRmse(FitCurve(exact.stamps, exact.values), exact), 1e-6);
+  // A recording of one or two windows has no interior to place artificial ends in: unchanged.
+  const Samples short_noisy = Sample(1.0, 100.0, 1e-3, 2);
+  CurveOptions without;
+  without.end_caps = false;
+  const Curve a = FitCurve(short_noisy.stamps, short_noisy.values);
+  const Curve b = FitCurve(short_noisy.stamps, short_noisy.values, without);
+  ASSERT_LT(b.segments()[0].windows.size(), 3u);
+  EXPECT_EQ(a.segments()[0].windows.size(), b.segments()[0].windows.size());
+  EXPECT_EQ(VelocityRmse(a, short_noisy), VelocityRmse(b, short_noisy));
+}
+
 TEST(FitCurve, EndWindowsChosenByVelocityRiskImproveTheEnds) {
   // Without the end caps, which act on the same ends after this option.
   const EndErrors e = GaitEndErrors([](CurveOptions* o, bool on) {
