@@ -299,28 +299,28 @@ void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloci
     choices[front ? 0 : 1] = ChooseCap(t, z, velocity, lo, hi, last - first, w, end_samples, core_samples);
   }
   // The back first, so that inserting at the front leaves nothing to re-find.
-  if (choices[1].samples > 0) {
-    const Choice& c = choices[1];
-    CurveWindow& w = windows.back();
-    const double boundary = t[last - 1 - c.boundary];
-    if (boundary > w.core_begin && boundary < w.core_end) {
-      CurveWindow cap = BuildCap(t, z, last - c.samples, c, w);
-      cap.core_begin = boundary;
-      cap.core_end = w.core_end;
-      w.core_end = boundary;
-      windows.push_back(std::move(cap));
+  for (const bool front : {false, true}) {
+    const Choice& choice = choices[front ? 0 : 1];
+    if (choice.samples == 0) continue;
+    CurveWindow& end_window = front ? windows.front() : windows.back();
+    const double boundary = front ? t[first + choice.boundary] : t[last - 1 - choice.boundary];
+    if (!(boundary > end_window.core_begin && boundary < end_window.core_end)) continue;  // repeated stamps
+    CurveWindow cap;
+    try {
+      cap = BuildCap(t, z, front ? first : last - choice.samples, choice, end_window);
+    } catch (const ComputeError&) {
+      continue;  // the end's own samples do not determine the cap (repeated stamps): no cap
     }
-  }
-  if (choices[0].samples > 0) {
-    const Choice& c = choices[0];
-    CurveWindow& w = windows.front();
-    const double boundary = t[first + c.boundary];
-    if (boundary > w.core_begin && boundary < w.core_end) {
-      CurveWindow cap = BuildCap(t, z, first, c, w);
-      cap.core_begin = w.core_begin;
+    if (front) {
+      cap.core_begin = end_window.core_begin;
       cap.core_end = boundary;
-      w.core_begin = boundary;
+      end_window.core_begin = boundary;
       windows.insert(windows.begin(), std::move(cap));
+    } else {
+      cap.core_begin = boundary;
+      cap.core_end = end_window.core_end;
+      end_window.core_end = boundary;
+      windows.push_back(std::move(cap));
     }
   }
 }
