@@ -9,11 +9,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <numbers>
 #include <stdexcept>
 #include <vector>
 
 #include <Eigen/Geometry>
 
+#include "cheval/cheb/curve.h"
 #include "cheval/cheb/model.h"
 #include "cheval/common/error.h"
 #include "cheval/traj/io.h"
@@ -413,6 +415,81 @@ std::optional<std::string> CheckModelInput(std::string_view data) {
       }
     }
   }
+  return std::nullopt;
+}
+
+namespace {
+
+struct CurveSamples {
+  std::vector<int64_t> stamps;
+  Eigen::MatrixXd values;
+};
+
+CurveSamples DecodeCurveSamples(std::string_view data) {
+  CurveSamples out;
+  const int d = 1 + static_cast<unsigned char>(data[0]) % 3;
+  const size_t record = 1 + static_cast<size_t>(d), count = (data.size() - 1) / record;
+  out.values.resize(static_cast<Eigen::Index>(count), d);
+  int64_t stamp = 1'403'636'580'000'000'000;  // EuRoC-like absolute stamps
+  for (size_t i = 0; i < count; ++i) {
+    const auto* r = reinterpret_cast<const unsigned char*>(data.data() + 1 + i * record);
+    const int code = r[0];
+    stamp += code <= 250 ? int64_t{code} * 50'000 : int64_t{code - 250} * 100'000'000;
+    out.stamps.push_back(stamp);
+    const double t = static_cast<double>(stamp - out.stamps.front()) * 1e-9;
+    for (int c = 0; c < d; ++c) {
+      const double motion = 0.3 * t * (c == 0) + 0.02 * std::sin(2 * std::numbers::pi * 2.3 * t + c) + 0.004 * std::cos(9.0 * t);
+      out.values(static_cast<Eigen::Index>(i), c) = motion + 1e-4 * static_cast<signed char>(r[1 + c]);
+    }
+  }
+  return out;
+}
+
+// The properties of one fitted curve (CheckCurveInput).
+Violation CheckFittedCurve(const cheb::Curve& curve, const CurveSamples& samples, const char* which) {
+  const std::string name(which);
+  for (const cheb::CurveSegment& segment : curve.segments()) {
+    const auto& windows = segment.windows;
+    FUZZ_REQUIRE(!windows.empty(), name);
+    FUZZ_REQUIRE(windows.front().core_begin == segment.begin && windows.back().core_end == segment.end, name);
+    for (size_t k = 0; k < windows.size(); ++k) {
+      FUZZ_REQUIRE(windows[k].core_begin < windows[k].core_end, name + " window " + std::to_string(k));
+      FUZZ_REQUIRE(windows[k].fit_begin <= windows[k].core_begin && windows[k].fit_end >= windows[k].core_end,
+                   name + " window " + std::to_string(k));
+      if (k > 0) FUZZ_REQUIRE(windows[k].core_begin == windows[k - 1].core_end, name + " window " + std::to_string(k));
+    }
+  }
+  // Curve::FromParts throws std::invalid_argument for parts that do not tile: that escapes as a bug.
+  cheb::Curve::FromParts(curve.origin_ns(), curve.segments(), curve.noise_sigma(), curve.residual_rms());
+  Eigen::MatrixXd p, v, a;
+  curve.EvaluateMany(samples.stamps, 2, &p, &v, &a);
+  FUZZ_REQUIRE(p.allFinite() && v.allFinite() && a.allFinite(), name);
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<std::string> CheckCurveInput(std::string_view data) {
+  if (data.size() < 2) return std::nullopt;
+  const CurveSamples samples = DecodeCurveSamples(data);
+  std::optional<cheb::Curve> with, without;
+  std::string with_error, without_error;
+  cheb::CurveOptions options;
+  try {
+    with = cheb::FitCurve(samples.stamps, samples.values, options);
+  } catch (const ComputeError& e) {
+    with_error = e.what();
+  }
+  options.end_caps = false;
+  try {
+    without = cheb::FitCurve(samples.stamps, samples.values, options);
+  } catch (const ComputeError& e) {
+    without_error = e.what();
+  }
+  FUZZ_REQUIRE(with.has_value() == without.has_value(), "with caps: '" + with_error + "', without: '" + without_error + "'");
+  if (!with) return std::nullopt;
+  FUZZ_PROPAGATE(CheckFittedCurve(*with, samples, "with end caps"));
+  FUZZ_PROPAGATE(CheckFittedCurve(*without, samples, "without end caps"));
   return std::nullopt;
 }
 

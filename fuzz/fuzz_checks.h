@@ -57,4 +57,13 @@ std::optional<std::string> CheckStampInput(std::string_view data);
 /// interval end is below 1e100 in magnitude). Returns nullopt or the violated property.
 std::optional<std::string> CheckModelInput(std::string_view data);
 
+/// Runs the curve target on `data`: byte 0 gives the dimension d = 1 + byte0 % 3, and every further
+/// record of 1 + d bytes is one sample — a stamp step (0: the same stamp again; 1..250: that many
+/// 50 µs; 251..255: a gap of (code − 250) · 0.1 s) and d signed bytes of noise (× 0.1 mm) on a smooth
+/// 2.3 Hz gait-like motion (DecodeCurveSamples). FitCurve on them, with and without the end caps,
+/// must either both throw cheval::ComputeError or both give curves whose windows tile each segment,
+/// that Curve::FromParts accepts, and whose value, velocity and acceleration are finite at every
+/// sample. Returns nullopt or the violated property.
+std::optional<std::string> CheckCurveInput(std::string_view data);
+
 }  // namespace cheval::fuzz

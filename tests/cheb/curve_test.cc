@@ -295,7 +295,9 @@ TEST(FitCurve, EndCapsAreWindowsThatTileTheSegmentAndJoinSmoothly) {
   EXPECT_EQ(windows.size(), plain_windows.size() + (front ? 1 : 0) + (back ? 1 : 0));
   EXPECT_TRUE(front || back) << "this noisy recording is expected to get at least one cap";
   for (size_t k = 0; k < windows.size(); ++k) {
-    if (k > 0) EXPECT_EQ(windows[k].core_begin, windows[k - 1].core_end);
+    if (k > 0) {
+      EXPECT_EQ(windows[k].core_begin, windows[k - 1].core_end);
+    }
     EXPECT_LT(windows[k].core_begin, windows[k].core_end);
     EXPECT_LE(windows[k].fit_begin, windows[k].core_begin);
     EXPECT_GE(windows[k].fit_end, windows[k].core_end);

@@ -30,6 +30,7 @@ std::vector<std::string> Targets() {
   std::vector<std::string> targets(cheval::fuzz::kTrajectoryTargets.begin(), cheval::fuzz::kTrajectoryTargets.end());
   targets.push_back("stamp");
   targets.push_back("model");
+  targets.push_back("curve");
   return targets;
 }
 
@@ -71,6 +72,7 @@ TEST_P(FuzzRegressionTest, ParsesWithPropertiesOrThrowsInputError) {
   const std::optional<std::string> violation =
       input.target == "stamp"   ? cheval::fuzz::CheckStampInput(bytes)
       : input.target == "model" ? cheval::fuzz::CheckModelInput(bytes)
+      : input.target == "curve" ? cheval::fuzz::CheckCurveInput(bytes)
                                 : cheval::fuzz::CheckTrajectoryInput(input.target, bytes);
   EXPECT_EQ(violation, std::nullopt) << input.file;
 }
