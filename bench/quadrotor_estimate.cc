@@ -57,6 +57,7 @@ Row Run(const estim::Vehicle& vehicle, sim::QuadrotorScenario scenario, uint64_t
 int main(int argc, char** argv) {
   std::string vehicle_path = CHEVAL_DEFAULT_VEHICLE;
   int seeds = 3;
+  int first_seed = 1;
   bool scaling = false;
   double duration = 10.0;
   std::string only, dump;
@@ -77,6 +78,13 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--fixed-prior")) options.adaptive_rotor_prior = false;
     else if (!std::strcmp(argv[i], "--floor") && i + 1 < argc) options.adaptive_rotor_prior_floor = std::stod(argv[++i]);
     else if (!std::strcmp(argv[i], "--pilot-iterations") && i + 1 < argc) options.pilot_iterations = std::stoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--sigma-u2") && i + 1 < argc) options.sigma_rotor_acceleration = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--floor2") && i + 1 < argc) options.second_order_floor = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--split")) options.collective_split = true;
+    else if (!std::strcmp(argv[i], "--em")) options.posterior_variance = true;
+    else if (!std::strcmp(argv[i], "--em-iterations") && i + 1 < argc) options.em_iterations = std::stoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--scale") && i + 1 < argc) options.adaptive_scale = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--first-seed") && i + 1 < argc) first_seed = std::stoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--full-report")) full_report = true;
     else if (!std::strcmp(argv[i], "--trust-radius") && i + 1 < argc) options.initial_trust_region_radius = std::stod(argv[++i]);
     else if (!std::strcmp(argv[i], "--window") && i + 1 < argc) options.initial_window_s = std::stod(argv[++i]);
@@ -91,7 +99,7 @@ int main(int argc, char** argv) {
     double worst = 0;
     for (sim::QuadrotorScenario scenario : sim::AllQuadrotorScenarios()) {
       if (!only.empty() && sim::ToString(scenario) != only) continue;
-      for (int seed = 1; seed <= seeds; ++seed) {
+      for (int seed = first_seed; seed <= seeds; ++seed) {
         const Row r = Run(vehicle, scenario, seed, duration, options, dump);
         const auto& e = r.errors;
         std::printf("%-11s %4d %6d %4d %7.3f | %7.2f %7.2f %7.2f %7.2f | %6.3f %6.3f %6.3f %6.3f | %8.4f %8.3f %8.4f%s\n",

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include <Eigen/Dense>
 
@@ -179,7 +181,18 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   sigma << Eigen::Vector3d::Constant(options.sigma_position_rate), Eigen::Vector3d::Constant(options.sigma_acceleration),
       Eigen::Vector3d::Constant(options.sigma_angular_acceleration), Eigen::Vector3d::Constant(options.sigma_rotation_rate);
   problem.AddCollocation(sigma);
-  if (options.sigma_rotor_rate > 0) problem.AddControlSmoothnessPrior(options.rotor_prior_order, options.sigma_rotor_rate);
+  Eigen::Matrix4d prior_basis = Eigen::Matrix4d::Identity();
+  if (options.collective_split) {
+    prior_basis << 1, 1, -1, -1,  //
+        1, 1, 1, 1,               //
+        1, -1, 1, -1,             //
+        1, -1, -1, 1;
+    prior_basis *= 0.5;
+  }
+  if (options.sigma_rotor_rate > 0) {
+    problem.AddControlSmoothnessPrior(options.rotor_prior_order, options.sigma_rotor_rate, prior_basis);
+  }
+  if (options.sigma_rotor_acceleration > 0) problem.AddControlSmoothnessPrior(2, options.sigma_rotor_acceleration, prior_basis);
 
   const PinholeCamera& cam = vehicle.camera;
   const double pixel_sigma = std::max(cam.pixel_noise_px, 0.1);  // a noise-free file still gets a finite weight
@@ -217,16 +230,100 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   solver.num_threads = options.threads;
   solver.logging_type = ceres::SILENT;
   solver.initial_trust_region_radius = options.initial_trust_region_radius;
-  const bool adaptive = options.adaptive_rotor_prior && options.sigma_rotor_rate > 0 && options.rotor_prior_order == 1;
+  const bool adaptive = options.adaptive_rotor_prior && options.sigma_rotor_rate > 0 &&
+                        (options.rotor_prior_order == 1 || options.rotor_prior_order == 2);
   if (adaptive) solver.max_num_iterations = options.pilot_iterations;
   ceres::Solver::Summary summary = problem.Solve(solver);
   int iterations = static_cast<int>(summary.iterations.size()) - 1;
   if (adaptive) {  // empirical Bayes: σ per segment from the pilot's rotor speeds, then the solve
-    std::vector<double> energy(problem.num_segments());
-    for (int s = 0; s < problem.num_segments(); ++s) energy[s] = problem.ControlDerivativeEnergy(1, s);
-    const std::vector<double> segment_sigma = AdaptiveRotorPriorSigma(energy, options.degree, QuadrotorModel::kControlDim);
-    for (int s = 0; s < problem.num_segments(); ++s) {
-      problem.SetControlSmoothnessSigma(s, std::max(options.adaptive_rotor_prior_floor, segment_sigma[s]));
+    const int S = problem.num_segments(), N = options.degree;
+    struct Prior {
+      int order;
+      double floor;
+    };
+    std::vector<Prior> priors{{options.rotor_prior_order, options.rotor_prior_order == 1 ? options.adaptive_rotor_prior_floor
+                                                                                         : options.second_order_floor}};
+    if (options.sigma_rotor_acceleration > 0) priors.push_back({2, options.second_order_floor});
+    for (int em = 0; em < std::max(1, options.em_iterations); ++em) {
+      // Posterior covariance of every segment's rotor blocks (the E-step's variance term).
+      std::vector<Eigen::MatrixXd> cov;
+      if (options.posterior_variance) {
+        ceres::Covariance::Options co;
+        co.num_threads = options.threads;
+        co.algorithm_type = ceres::SPARSE_QR;
+        ceres::Covariance covariance(co);
+        std::vector<std::pair<const double*, const double*>> pairs;
+        for (int s = 0; s < S; ++s) {
+          for (int k = 0; k <= N; ++k) {
+            for (int l = k; l <= N; ++l) {
+              const int a = problem.NodeOf(s, k), b = problem.NodeOf(s, l);
+              if (s > 0 && (k == N && l == N)) continue;  // the shared start node: already its predecessor's end
+              pairs.emplace_back(problem.Control(std::min(a, b)), problem.Control(std::max(a, b)));
+            }
+          }
+        }
+        if (!covariance.Compute(pairs, &problem.ceres_problem())) throw ComputeError("the rotor covariance failed");
+        for (int s = 0; s < S; ++s) {
+          Eigen::MatrixXd C(4 * (N + 1), 4 * (N + 1));
+          for (int k = 0; k <= N; ++k) {
+            for (int l = k; l <= N; ++l) {
+              const int a = problem.NodeOf(s, k), b = problem.NodeOf(s, l);
+              Eigen::Matrix<double, 4, 4, Eigen::RowMajor> block;
+              covariance.GetCovarianceBlock(problem.Control(a), problem.Control(b), block.data());
+              C.block<4, 4>(4 * k, 4 * l) = block;
+              C.block<4, 4>(4 * l, 4 * k) = block.transpose();
+            }
+          }
+          cov.push_back(C);
+        }
+      }
+      Eigen::Matrix4d basis = Eigen::Matrix4d::Identity();
+      if (options.collective_split) {
+        basis << 1, 1, -1, -1,  //
+            1, 1, 1, 1,         //
+            1, -1, 1, -1,       //
+            1, -1, -1, 1;
+        basis *= 0.5;  // columns: collective, roll, pitch, yaw (the mixer's rows: models.h)
+      }
+      for (const Prior& prior : priors) {
+        std::vector<Eigen::Vector4d> energy(S);
+        for (int s = 0; s < S; ++s) {
+          energy[s] = problem.ControlDerivativeEnergies(prior.order, s, basis);
+          if (options.posterior_variance) {
+            const Eigen::MatrixXd M = problem.SmoothnessMatrix(prior.order, s);  // rows x N + 1
+            for (int j = 0; j < 4; ++j) {
+              Eigen::MatrixXd A(M.rows(), 4 * (N + 1));
+              for (int q = 0; q < M.rows(); ++q) {
+                for (int k = 0; k <= N; ++k) A.block(q, 4 * k, 1, 4) = M(q, k) * basis.col(j).transpose();
+              }
+              energy[s][j] += (A * cov[s] * A.transpose()).trace();
+            }
+          }
+        }
+        const double increments = N + 1 - prior.order;  // rank of one segment's prior per component
+        for (int s = 0; s < S; ++s) {
+          Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+          int pooled = 0;
+          for (int n = std::max(s - 1, 0); n <= std::min(s + 1, S - 1); ++n, ++pooled) sum += energy[n];
+          Eigen::Vector4d seg_sigma;
+          if (options.collective_split) {
+            seg_sigma = (sum / (pooled * increments)).cwiseSqrt();
+          } else {
+            seg_sigma.setConstant(std::sqrt(sum.sum() / (pooled * increments * 4)));
+          }
+          seg_sigma = (options.adaptive_scale * seg_sigma).cwiseMax(prior.floor);
+          problem.SetControlSmoothnessSigmas(prior.order, s, seg_sigma);
+          if (std::getenv("CHEVAL_DEBUG_SIGMA")) {
+            std::fprintf(stderr, "em %d order %d segment %d sigma %.1f %.1f %.1f %.1f\n", em, prior.order, s, seg_sigma[0],
+                         seg_sigma[1], seg_sigma[2], seg_sigma[3]);
+          }
+        }
+      }
+      if (em + 1 < options.em_iterations) {
+        solver.max_num_iterations = options.pilot_iterations;
+        summary = problem.Solve(solver);
+        iterations += static_cast<int>(summary.iterations.size()) - 1;
+      }
     }
     solver.max_num_iterations = options.max_iterations;
     summary = problem.Solve(solver);

@@ -51,6 +51,21 @@ struct QuadrotorEstimateOptions {
   bool adaptive_rotor_prior = true;
   int pilot_iterations = 1;                ///< Levenberg–Marquardt iterations of the pilot solve (>= 1)
   double adaptive_rotor_prior_floor = 30;  ///< lower bound of the per-segment σ, rad/s² per s^(1/2) (> 0)
+  /// Experimental (docs/estimator.md, "What was tried"): a second prior ∫ |Ω''|² dt / σ₂² beside the
+  /// order-1 one, σ₂ this in the pilot (0 = none), per segment by the same empirical Bayes
+  /// (maximum-likelihood intensity over N − 1 increments) with `second_order_floor`.
+  double sigma_rotor_acceleration = 0;
+  double second_order_floor = 300;
+  /// Experimental: the prior on the collective (mean of the 4 rotors) and the 3 differential
+  /// (roll, pitch, yaw) rotor-speed combinations (an orthonormal basis), each with its own σ.
+  bool collective_split = false;
+  /// Experimental: EM instead of the plug-in intensity — the posterior variance of the pilot's rotor
+  /// rates (ceres::Covariance of each segment's rotor blocks) added to ∫|Ω̂'|²; `em_iterations` E/M
+  /// steps (each: covariance, σ update, `pilot_iterations` LM iterations) before the final solve.
+  bool posterior_variance = false;
+  int em_iterations = 1;
+  /// Experimental: a factor on every empirical-Bayes σ (1: the maximum-likelihood value).
+  double adaptive_scale = 1.0;
   double huber_pixels = 3.0;  ///< Huber threshold on each landmark's whitened pixel error (in σ)
   /// Window of the flatness-based initialisation (FlatnessInitialState), s (> 0).
   double initial_window_s = 0.6;
