@@ -374,7 +374,27 @@ class PseudoSpectralProblem {
 
   /// The rows of ∫_s |u^(m)|² dt (rows x N + 1 nodes of segment s, point order k = 0..N): the
   /// energy of a control entry is |C U|².
-  Eigen::MatrixXd SmoothnessMatrix(int order, int s) const { return SmoothnessRows(order, s); }
+  Eigen::MatrixXd SmoothnessMatrix(int order, int s, int points = 0) const { return SmoothnessRows(order, s, points); }
+
+  /// The jump rows of the order-m prior with σ at the breakpoint between segments s and s + 1
+  /// (order − 1 rows over the global nodes s·N .. (s + 2)·N, in that order); empty for m = 1.
+  Eigen::MatrixXd SmoothnessJumpMatrix(int order, int s, double sigma) const {
+    const int N = degree_;
+    const double h_unit = 1.0 - basis_.points()[1];
+    const double scale_a = Interval(s).DerivativeScale(), scale_b = Interval(s + 1).DerivativeScale();
+    const double h = std::min(h_unit / scale_a, h_unit / scale_b);
+    Eigen::MatrixXd coefficients = Eigen::MatrixXd::Zero(order - 1, 2 * N + 1);
+    Eigen::MatrixXd Di = Eigen::MatrixXd::Identity(N + 1, N + 1);
+    for (int i = 1; i < order; ++i) {
+      Di = D_ * Di;
+      const double sigma_i = sigma * std::pow(h, order - i - 0.5);
+      for (int k = 0; k <= N; ++k) {
+        coefficients(i - 1, NodeOf(s, k) - s * N) += std::pow(scale_a, i) * Di(0, k) / sigma_i;
+        coefficients(i - 1, NodeOf(s + 1, k) - s * N) -= std::pow(scale_b, i) * Di(N, k) / sigma_i;
+      }
+    }
+    return coefficients;
+  }
 
   /// Adds the measurement residual h(x(t)) at time t. `F` has
   /// `template <class T> bool operator()(const T* x, const Eigen::Matrix<T,3,3>& R, T* residual) const`
@@ -433,11 +453,11 @@ class PseudoSpectralProblem {
  private:
   // Rows sqrt(w_q L/2) u^(m)(t_q) over the controls of segment s in point order k = 0..N: their
   // squared sum is ∫_s |u^(m)|² dt, exactly (Gauss–Legendre with N − m + 1 points).
-  Eigen::MatrixXd SmoothnessRows(int order, int s) const {
+  Eigen::MatrixXd SmoothnessRows(int order, int s, int points = 0) const {
     const int N = degree_;
     Eigen::MatrixXd Dm = Eigen::MatrixXd::Identity(N + 1, N + 1);
     for (int i = 0; i < order; ++i) Dm = D_ * Dm;
-    const int nq = N - order + 1;
+    const int nq = points > 0 ? points : N - order + 1;
     Eigen::VectorXd xq, wq;
     detail::GaussLegendre(nq, &xq, &wq);
     Eigen::RowVectorXd row(N + 1);

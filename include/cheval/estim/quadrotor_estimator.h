@@ -64,6 +64,27 @@ struct QuadrotorEstimateOptions {
   /// steps (each: covariance, σ update, `pilot_iterations` LM iterations) before the final solve.
   bool posterior_variance = false;
   int em_iterations = 1;
+  /// Experimental: the collective's prior on the world-frame thrust acceleration f = (k_F ΣΩ²/m) R e3,
+  /// ∫ |f^(m)|² dt / σ_f² with this m (0 = off; needs collective_split), σ_f per segment by empirical
+  /// Bayes; the collective rotor-speed prior then off (or × thrust_keep_collective if > 0).
+  int thrust_vector_prior_order = 0;
+  bool thrust_vector_jumps = true;
+  double thrust_floor_factor = 1.0;
+  bool thrust_differential_own = false;
+  double thrust_keep_collective = 0;
+  /// Experimental (with thrust_vector_prior_order 2): ∫ |f'' + ω_a² (f − ḡ)|² per axis a (ḡ the hover
+  /// thrust), ω_a² by least squares from the pilot, clamped to [0, thrust_oscillator_max²].
+  bool thrust_oscillator = false;
+  double thrust_damping = 0;  ///< experimental: ζ of the oscillator, L = D² + 2ζωD + ω²
+  double thrust_matern = 0;   ///< experimental: > 0: ω fixed to this (with ζ = 1: a Matérn-3/2 acceleration)
+  bool thrust_matern_ml = false;  ///< experimental: λ of the Matérn prior by type-II maximum likelihood
+  int thrust_pool = 1;  ///< experimental: the thrust σ pools segments s − this .. s + this
+  bool thrust_stationary_start = false;  ///< experimental: the stationary Matérn prior of the first state
+  bool thrust_stationary_both = false;   ///< experimental: ... and of the last
+  bool thrust_em = false;  ///< experimental: EM for the thrust σ (posterior variance from ceres::Covariance, em_iterations)
+  double thrust_scale = 1.0;  ///< experimental: a factor on the thrust prior's σ alone
+  bool thrust_oscillator_isotropic = false;
+  double thrust_oscillator_max = 6.0;
   /// Experimental: a factor on every empirical-Bayes σ (1: the maximum-likelihood value).
   double adaptive_scale = 1.0;
   double huber_pixels = 3.0;  ///< Huber threshold on each landmark's whitened pixel error (in σ)
