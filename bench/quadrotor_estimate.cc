@@ -1,12 +1,14 @@
 // Measured figures of docs/estimator.md (a plain program: it prints tables, it does not assert).
 //   quadrotor_estimate [VEHICLE_JSON] [--seeds N] [--scaling]
-// 1. Every scenario x seeds 1..N (default 3): per-motor mean rotor-speed error (rpm, %), pose and
+// 1. Every scenario x seeds 1..N (default 3; --first-seed K: K..N): per-motor mean rotor-speed error (rpm, %), pose and
 //    velocity RMSE, states, iterations, seconds (one core).
 // 2. --scaling: figure-eight flights of 10 s .. 300 s at the default segment length: seconds per state.
 // Options (defaults: QuadrotorEstimateOptions): --duration S, --degree N, --segment S, --order M and
 // --sigma-u σ (rotor smoothness prior; the pilot's with the adaptive prior), --fixed-prior (σ_u
 // everywhere, no empirical Bayes), --floor σ and --pilot-iterations K (adaptive prior),
+// --no-thrust-prior (the collective's random-walk rotor prior instead of the thrust-acceleration one),
 // --sigma-p/-v/-w/-r σ (collocation), --trust-radius R, --window S (initialisation), --only SCENARIO,
+// --first-seed K (seeds K..N),
 // --full-report (Ceres' report of the final solve, with stage times), --dump PREFIX (writes
 // PREFIX_<scenario>_<seed>.txt: t, estimated rotor 0..3, true rotor 0..3).
 #include <cstdio>
@@ -78,28 +80,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--fixed-prior")) options.adaptive_rotor_prior = false;
     else if (!std::strcmp(argv[i], "--floor") && i + 1 < argc) options.adaptive_rotor_prior_floor = std::stod(argv[++i]);
     else if (!std::strcmp(argv[i], "--pilot-iterations") && i + 1 < argc) options.pilot_iterations = std::stoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--sigma-u2") && i + 1 < argc) options.sigma_rotor_acceleration = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--floor2") && i + 1 < argc) options.second_order_floor = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--split")) options.collective_split = true;
-    else if (!std::strcmp(argv[i], "--thrust-order") && i + 1 < argc) options.thrust_vector_prior_order = std::stoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--thrust-nojumps")) options.thrust_vector_jumps = false;
-    else if (!std::strcmp(argv[i], "--osc")) options.thrust_oscillator = true;
-    else if (!std::strcmp(argv[i], "--thrust-em")) options.thrust_em = true;
-    else if (!std::strcmp(argv[i], "--stat-start")) options.thrust_stationary_start = true;
-    else if (!std::strcmp(argv[i], "--stat-both")) options.thrust_stationary_both = options.thrust_stationary_start = true;
-    else if (!std::strcmp(argv[i], "--thrust-pool") && i + 1 < argc) options.thrust_pool = std::stoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--matern-ml")) options.thrust_matern_ml = true;
-    else if (!std::strcmp(argv[i], "--zeta") && i + 1 < argc) options.thrust_damping = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--matern") && i + 1 < argc) options.thrust_matern = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--thrust-scale") && i + 1 < argc) options.thrust_scale = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--osc-iso")) options.thrust_oscillator_isotropic = true;
-    else if (!std::strcmp(argv[i], "--osc-max") && i + 1 < argc) options.thrust_oscillator_max = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--thrust-floor") && i + 1 < argc) options.thrust_floor_factor = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--thrust-diff-own")) options.thrust_differential_own = true;
-    else if (!std::strcmp(argv[i], "--thrust-keep") && i + 1 < argc) options.thrust_keep_collective = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--em")) options.posterior_variance = true;
-    else if (!std::strcmp(argv[i], "--em-iterations") && i + 1 < argc) options.em_iterations = std::stoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--scale") && i + 1 < argc) options.adaptive_scale = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--no-thrust-prior")) options.thrust_prior = false;
     else if (!std::strcmp(argv[i], "--first-seed") && i + 1 < argc) first_seed = std::stoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--full-report")) full_report = true;
     else if (!std::strcmp(argv[i], "--trust-radius") && i + 1 < argc) options.initial_trust_region_radius = std::stod(argv[++i]);

@@ -6,13 +6,13 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
+#include <limits>
 
 #include <Eigen/Dense>
 
 #include "cheval/common/error.h"
 #include "cheval/estim/problem.h"
+#include "cheval/estim/thrust_vector_prior.h"
 #include "cheval/lie/so3.h"
 
 namespace cheval::estim {
@@ -53,80 +53,6 @@ struct InitialTrajectory {
     const double f = b.t > a.t ? (t - a.t) / (b.t - a.t) : 0.0;
     return {t, a.p + f * (b.p - a.p), a.q.slerp(f, b.q)};
   }
-};
-
-
-// Rows w (Σ_k C_a(q, k) f_k[a] + o(q, a)) (axis a = x, y, z) of the thrust acceleration
-// f_k = (k_F/m) Σ_i Ω_ik² R_k e3 (world frame) of the given nodes: with C_a the smoothness rows of a
-// segment, ∫ |f^(m)|² dt / σ² of the polynomial through the nodes' f (a white-noise prior on the m-th
-// derivative of the thrust vector); with C_a = rows of D² + ω_a² and o = −ω² ḡ, ∫ |f'' + ω²(f − ḡ)|².
-class ThrustVectorSmoothnessCost : public ceres::CostFunction {
- public:
-  ThrustVectorSmoothnessCost(Problem& p, const std::vector<int>& nodes, std::array<Eigen::MatrixXd, 3> coefficients,
-                             Eigen::MatrixXd offsets, double k_over_m)
-      : coefficients_(std::move(coefficients)), offsets_(std::move(offsets)), k_over_m_(k_over_m) {
-    for (int g : nodes) {
-      blocks_.push_back(p.Control(g));
-      blocks_.push_back(p.Quaternion(g));
-      mutable_parameter_block_sizes()->push_back(4);
-      mutable_parameter_block_sizes()->push_back(4);
-    }
-    if (offsets_.size() == 0) offsets_ = Eigen::MatrixXd::Zero(coefficients_[0].rows(), 3);
-    set_num_residuals(3 * static_cast<int>(coefficients_[0].rows()));
-  }
-  ThrustVectorSmoothnessCost(Problem& p, const std::vector<int>& nodes, const Eigen::MatrixXd& coefficients, double k_over_m)
-      : ThrustVectorSmoothnessCost(p, nodes, {coefficients, coefficients, coefficients}, Eigen::MatrixXd(), k_over_m) {}
-  const std::vector<double*>& blocks() const { return blocks_; }
-  void set_weight(double w) { weight_ = w; }
-  void set_rows(std::array<Eigen::MatrixXd, 3> coefficients, Eigen::MatrixXd offsets) {
-    coefficients_ = std::move(coefficients);
-    offsets_ = std::move(offsets);
-  }
-  static Eigen::Vector3d ThrustAcceleration(const double* u, const double* q, double k_over_m) {
-    const double x = q[0], y = q[1], z = q[2], w = q[3];
-    const Eigen::Vector3d b3(2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y));
-    return k_over_m * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + u[3] * u[3]) * b3;
-  }
-  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const int rows = static_cast<int>(coefficients_[0].rows()), nodes = static_cast<int>(coefficients_[0].cols());
-    Eigen::Map<Eigen::VectorXd> r(residuals, 3 * rows);
-    for (int row = 0; row < rows; ++row) r.segment<3>(3 * row) = weight_ * offsets_.row(row).transpose();
-    for (int k = 0; k < nodes; ++k) {
-      const double* u = parameters[2 * k];
-      const double* q = parameters[2 * k + 1];
-      const Eigen::Vector3d f = ThrustAcceleration(u, q, k_over_m_);
-      for (int row = 0; row < rows; ++row) {
-        for (int a = 0; a < 3; ++a) r[3 * row + a] += weight_ * coefficients_[a](row, k) * f[a];
-      }
-      if (!jacobians) continue;
-      const double x = q[0], y = q[1], z = q[2], w = q[3];
-      const double t = k_over_m_ * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + u[3] * u[3]);
-      const Eigen::Vector3d b3(2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y));
-      Eigen::Matrix<double, 3, 4> df_du = (2 * k_over_m_) * b3 * Eigen::Map<const Eigen::RowVector4d>(u);
-      Eigen::Matrix<double, 3, 4> df_dq;
-      df_dq.col(0) = Eigen::Vector3d(2 * z, -2 * w, -4 * x);
-      df_dq.col(1) = Eigen::Vector3d(2 * w, 2 * z, -4 * y);
-      df_dq.col(2) = Eigen::Vector3d(2 * x, 2 * y, 0);
-      df_dq.col(3) = Eigen::Vector3d(2 * y, -2 * x, 0);
-      df_dq *= t;
-      for (int b = 0; b < 2; ++b) {
-        if (!jacobians[2 * k + b]) continue;
-        Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor>> J(jacobians[2 * k + b], 3 * rows, 4);
-        const Eigen::Matrix<double, 3, 4>& df = b == 0 ? df_du : df_dq;
-        for (int row = 0; row < rows; ++row) {
-          for (int a = 0; a < 3; ++a) J.row(3 * row + a) = weight_ * coefficients_[a](row, k) * df.row(a);
-        }
-      }
-    }
-    return true;
-  }
-
- private:
-  std::vector<double*> blocks_;
-  std::array<Eigen::MatrixXd, 3> coefficients_;
-  Eigen::MatrixXd offsets_;
-  double k_over_m_;
-  double weight_ = 1.0;
 };
 
 }  // namespace
@@ -256,41 +182,16 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   sigma << Eigen::Vector3d::Constant(options.sigma_position_rate), Eigen::Vector3d::Constant(options.sigma_acceleration),
       Eigen::Vector3d::Constant(options.sigma_angular_acceleration), Eigen::Vector3d::Constant(options.sigma_rotation_rate);
   problem.AddCollocation(sigma);
-  Eigen::Matrix4d prior_basis = Eigen::Matrix4d::Identity();
-  if (options.collective_split) {
-    prior_basis << 1, 1, -1, -1,  //
-        1, 1, 1, 1,               //
-        1, -1, 1, -1,             //
-        1, -1, -1, 1;
-    prior_basis *= 0.5;
-  }
+  // The rotor prior on the collective and the roll, pitch and yaw combinations of the rotor speeds
+  // (the mixer's rows, orthonormal): with one σ for all four it is the per-rotor prior.
+  Eigen::Matrix4d rotor_basis;
+  rotor_basis << 1, 1, -1, -1,  //
+      1, 1, 1, 1,               //
+      1, -1, 1, -1,             //
+      1, -1, -1, 1;
+  rotor_basis *= 0.5;  // columns: collective, roll, pitch, yaw
   if (options.sigma_rotor_rate > 0) {
-    problem.AddControlSmoothnessPrior(options.rotor_prior_order, options.sigma_rotor_rate, prior_basis);
-  }
-  if (options.sigma_rotor_acceleration > 0) problem.AddControlSmoothnessPrior(2, options.sigma_rotor_acceleration, prior_basis);
-  // Experimental: the collective's prior on the world-frame thrust acceleration instead (weight 0 in the pilot).
-  std::vector<ThrustVectorSmoothnessCost*> thrust_costs, thrust_jumps, start_costs;
-  Eigen::Vector3d oscillator_lambda = Eigen::Vector3d::Zero();  // λ per axis of (D + λ)² (ζ = 1)
-  std::vector<std::pair<std::array<Eigen::MatrixXd, 3>, Eigen::MatrixXd>> oscillator_rows;
-  const double k_over_m = vehicle.quadrotor.thrust_coefficient / vehicle.quadrotor.mass_kg;
-  if (options.thrust_vector_prior_order > 0) {
-    const int m = options.thrust_vector_prior_order, N = options.degree;
-    for (int s = 0; s < problem.num_segments(); ++s) {
-      std::vector<int> nodes;
-      for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(s, k));
-      auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, problem.SmoothnessMatrix(m, s), k_over_m);
-      cost->set_weight(std::getenv("CHEVAL_CHECK_GRADIENTS") ? 1.0 : 0.0);
-      problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
-      thrust_costs.push_back(cost);
-    }
-    for (int s = 0; m > 1 && options.thrust_vector_jumps && s + 1 < problem.num_segments(); ++s) {
-      std::vector<int> nodes;
-      for (int g = s * N; g <= (s + 2) * N; ++g) nodes.push_back(g);
-      auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, problem.SmoothnessJumpMatrix(m, s, 1.0), k_over_m);
-      cost->set_weight(std::getenv("CHEVAL_CHECK_GRADIENTS") ? 1.0 : 0.0);
-      problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
-      thrust_jumps.push_back(cost);
-    }
+    problem.AddControlSmoothnessPrior(options.rotor_prior_order, options.sigma_rotor_rate, rotor_basis);
   }
 
   const PinholeCamera& cam = vehicle.camera;
@@ -329,313 +230,93 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   solver.num_threads = options.threads;
   solver.logging_type = ceres::SILENT;
   solver.initial_trust_region_radius = options.initial_trust_region_radius;
-  if (std::getenv("CHEVAL_CHECK_GRADIENTS")) solver.check_gradients = true;
-  const bool adaptive = options.adaptive_rotor_prior && options.sigma_rotor_rate > 0 &&
-                        (options.rotor_prior_order == 1 || options.rotor_prior_order == 2);
+  const bool adaptive = options.adaptive_rotor_prior && options.sigma_rotor_rate > 0 && options.rotor_prior_order == 1;
   if (adaptive) solver.max_num_iterations = options.pilot_iterations;
   ceres::Solver::Summary summary = problem.Solve(solver);
   int iterations = static_cast<int>(summary.iterations.size()) - 1;
   if (adaptive) {  // empirical Bayes: σ per segment from the pilot's rotor speeds, then the solve
     const int S = problem.num_segments(), N = options.degree;
-    struct Prior {
-      int order;
-      double floor;
-    };
-    std::vector<Prior> priors{{options.rotor_prior_order, options.rotor_prior_order == 1 ? options.adaptive_rotor_prior_floor
-                                                                                         : options.second_order_floor}};
-    if (options.sigma_rotor_acceleration > 0) priors.push_back({2, options.second_order_floor});
-    for (int em = 0; em < std::max(1, options.em_iterations); ++em) {
-      // Posterior covariance of every segment's rotor blocks (the E-step's variance term).
-      std::vector<Eigen::MatrixXd> cov;
-      if (options.posterior_variance) {
-        ceres::Covariance::Options co;
-        co.num_threads = options.threads;
-        co.algorithm_type = ceres::SPARSE_QR;
-        ceres::Covariance covariance(co);
-        std::vector<std::pair<const double*, const double*>> pairs;
-        for (int s = 0; s < S; ++s) {
-          for (int k = 0; k <= N; ++k) {
-            for (int l = k; l <= N; ++l) {
-              const int a = problem.NodeOf(s, k), b = problem.NodeOf(s, l);
-              if (s > 0 && (k == N && l == N)) continue;  // the shared start node: already its predecessor's end
-              pairs.emplace_back(problem.Control(std::min(a, b)), problem.Control(std::max(a, b)));
-            }
-          }
+    std::vector<double> energy(S);
+    for (int s = 0; s < S; ++s) energy[s] = problem.ControlDerivativeEnergy(1, s);
+    const std::vector<double> segment_sigma = AdaptiveRotorPriorSigma(energy, options.degree, QuadrotorModel::kControlDim);
+    const bool thrust = options.thrust_prior;
+    const double off = std::numeric_limits<double>::infinity();  // weight 0
+    for (int s = 0; s < S; ++s) {
+      const double sigma_s = std::max(options.adaptive_rotor_prior_floor, segment_sigma[s]);
+      problem.SetControlSmoothnessSigmas(1, s, Eigen::Vector4d(thrust ? off : sigma_s, sigma_s, sigma_s, sigma_s));
+    }
+    if (thrust) {  // the collective's prior: a Matérn process on the thrust acceleration (docs/estimator.md)
+      const double k_over_m = vehicle.quadrotor.thrust_coefficient / vehicle.quadrotor.mass_kg;
+      const Eigen::Vector3d gbar(0, 0, vehicle.quadrotor.gravity_mps2);
+      std::vector<Eigen::MatrixXd> F(S), Q0(S), Q1(S), Q2(S);  // pilot's f − ḡ at the nodes; GL rows of 1, D, D²
+      Eigen::Vector3d num = Eigen::Vector3d::Zero(), den = Eigen::Vector3d::Zero();
+      for (int s = 0; s < S; ++s) {
+        F[s].resize(N + 1, 3);
+        for (int k = 0; k <= N; ++k) {
+          const int g = problem.NodeOf(s, k);
+          F[s].row(k) = (ThrustVectorSmoothnessCost::ThrustAcceleration(problem.Control(g), problem.Quaternion(g), k_over_m) -
+                         gbar).transpose();
         }
-        if (!covariance.Compute(pairs, &problem.ceres_problem())) throw ComputeError("the rotor covariance failed");
-        for (int s = 0; s < S; ++s) {
-          Eigen::MatrixXd C(4 * (N + 1), 4 * (N + 1));
-          for (int k = 0; k <= N; ++k) {
-            for (int l = k; l <= N; ++l) {
-              const int a = problem.NodeOf(s, k), b = problem.NodeOf(s, l);
-              Eigen::Matrix<double, 4, 4, Eigen::RowMajor> block;
-              covariance.GetCovarianceBlock(problem.Control(a), problem.Control(b), block.data());
-              C.block<4, 4>(4 * k, 4 * l) = block;
-              C.block<4, 4>(4 * l, 4 * k) = block.transpose();
-            }
-          }
-          cov.push_back(C);
-        }
-      }
-      Eigen::Matrix4d basis = Eigen::Matrix4d::Identity();
-      if (options.collective_split) {
-        basis << 1, 1, -1, -1,  //
-            1, 1, 1, 1,         //
-            1, -1, 1, -1,       //
-            1, -1, -1, 1;
-        basis *= 0.5;  // columns: collective, roll, pitch, yaw (the mixer's rows: models.h)
-      }
-      for (const Prior& prior : priors) {
-        std::vector<Eigen::Vector4d> energy(S);
-        for (int s = 0; s < S; ++s) {
-          energy[s] = problem.ControlDerivativeEnergies(prior.order, s, basis);
-          if (options.posterior_variance) {
-            const Eigen::MatrixXd M = problem.SmoothnessMatrix(prior.order, s);  // rows x N + 1
-            for (int j = 0; j < 4; ++j) {
-              Eigen::MatrixXd A(M.rows(), 4 * (N + 1));
-              for (int q = 0; q < M.rows(); ++q) {
-                for (int k = 0; k <= N; ++k) A.block(q, 4 * k, 1, 4) = M(q, k) * basis.col(j).transpose();
-              }
-              energy[s][j] += (A * cov[s] * A.transpose()).trace();
-            }
-          }
-        }
-        const double increments = N + 1 - prior.order;  // rank of one segment's prior per component
-        for (int s = 0; s < S; ++s) {
-          Eigen::Vector4d sum = Eigen::Vector4d::Zero();
-          int pooled = 0;
-          for (int n = std::max(s - 1, 0); n <= std::min(s + 1, S - 1); ++n, ++pooled) sum += energy[n];
-          Eigen::Vector4d seg_sigma;
-          if (options.collective_split) {
-            seg_sigma = (sum / (pooled * increments)).cwiseSqrt();
-          } else {
-            seg_sigma.setConstant(std::sqrt(sum.sum() / (pooled * increments * 4)));
-          }
-          seg_sigma = (options.adaptive_scale * seg_sigma).cwiseMax(prior.floor);
-          problem.SetControlSmoothnessSigmas(prior.order, s, seg_sigma);
-          if (std::getenv("CHEVAL_DEBUG_SIGMA")) {
-            std::fprintf(stderr, "em %d order %d segment %d sigma %.1f %.1f %.1f %.1f\n", em, prior.order, s, seg_sigma[0],
-                         seg_sigma[1], seg_sigma[2], seg_sigma[3]);
-          }
-        }
-      }
-      // Posterior covariance of each segment's thrust accelerations f_k (3 (N + 1) square, node-major), by
-      // linearising f in the controls and rotations: the E-step's variance term.
-      std::vector<Eigen::MatrixXd> covf;
-      if (options.thrust_em && em > 0 && !thrust_costs.empty()) {
-        ceres::Covariance::Options co;
-        co.num_threads = options.threads;
-        co.algorithm_type = ceres::SPARSE_QR;
-        ceres::Covariance covariance(co);
-        std::vector<std::pair<const double*, const double*>> pairs;
-        auto block = [&](int g, int b) -> const double* { return b == 0 ? problem.Control(g) : problem.Quaternion(g); };
-        for (int s = 0; s < S; ++s) {
-          for (int k = 0; k <= N; ++k) {
-            for (int l = k; l <= N; ++l) {
-              if (s > 0 && k == N && l == N) continue;
-              for (int b = 0; b < 2; ++b) {
-                for (int c = 0; c < 2; ++c) {
-                  if (k == l && c < b) continue;
-                  pairs.emplace_back(block(problem.NodeOf(s, k), b), block(problem.NodeOf(s, l), c));
-                }
-              }
-            }
-          }
-        }
-        if (!covariance.Compute(pairs, &problem.ceres_problem())) throw ComputeError("the thrust covariance failed");
-        for (int s = 0; s < S; ++s) {
-          Eigen::MatrixXd Sigma(7 * (N + 1), 7 * (N + 1));
-          for (int k = 0; k <= N; ++k) {
-            for (int l = k; l <= N; ++l) {
-              for (int b = 0; b < 2; ++b) {
-                for (int c = 0; c < 2; ++c) {
-                  if (k == l && c < b) continue;
-                  const int nb = b == 0 ? 4 : 3, nc = c == 0 ? 4 : 3;
-                  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> B(nb, nc);
-                  covariance.GetCovarianceBlockInTangentSpace(block(problem.NodeOf(s, k), b), block(problem.NodeOf(s, l), c), B.data());
-                  Sigma.block(7 * k + 4 * b, 7 * l + 4 * c, nb, nc) = B;
-                  Sigma.block(7 * l + 4 * c, 7 * k + 4 * b, nc, nb) = B.transpose();
-                }
-              }
-            }
-          }
-          Eigen::MatrixXd J = Eigen::MatrixXd::Zero(3 * (N + 1), 7 * (N + 1));
-          Eigen::Matrix3d e3x;
-          e3x << 0, -1, 0, 1, 0, 0, 0, 0, 0;
-          for (int k = 0; k <= N; ++k) {
-            const int g = problem.NodeOf(s, k);
-            const Eigen::Map<const Eigen::Vector4d> u(problem.Control(g));
-            const Eigen::Matrix3d R = Eigen::Quaterniond(Eigen::Map<const Eigen::Vector4d>(problem.Quaternion(g))).toRotationMatrix();
-            J.block<3, 4>(3 * k, 7 * k) = (2 * k_over_m) * R.col(2) * u.transpose();
-            J.block<3, 3>(3 * k, 7 * k + 4) = -k_over_m * u.squaredNorm() * R * e3x;
-          }
-          covf.push_back(J * Sigma * J.transpose());
-        }
-      }
-      // tr(A Cov(F_a) Aᵀ) summed over the axes.
-      auto variance = [&](int s, const std::array<Eigen::MatrixXd, 3>& A) {
-        double v = 0;
+        Q0[s] = problem.SmoothnessMatrix(0, s, N + 1);
+        Q1[s] = problem.SmoothnessMatrix(1, s, N + 1);
+        Q2[s] = problem.SmoothnessMatrix(2, s, N + 1);
+        const Eigen::MatrixXd A0 = Q0[s] * F[s], A2 = Q2[s] * F[s];
         for (int a = 0; a < 3; ++a) {
-          Eigen::MatrixXd Ca(N + 1, N + 1);
-          for (int k = 0; k <= N; ++k) {
-            for (int l = 0; l <= N; ++l) Ca(k, l) = covf[s](3 * k + a, 3 * l + a);
-          }
-          v += (A[a] * Ca * A[a].transpose()).trace();
-        }
-        return v;
-      };
-      if (options.thrust_oscillator && (em == 0 || (options.thrust_matern_ml && !covf.empty()))) {
-        // ω_a² per axis: least squares of â'' = −ω² â over the pilot's thrust acceleration minus hover
-        // (â = f − ḡ), at N + 1 Gauss–Legendre points per segment; clamped to [0, ω_max²].
-        const Eigen::Vector3d gbar(0, 0, vehicle.quadrotor.gravity_mps2);
-        Eigen::Vector3d num = Eigen::Vector3d::Zero(), den = Eigen::Vector3d::Zero();
-        std::vector<Eigen::MatrixXd> F(S);
-        std::vector<Eigen::MatrixXd> R0(S), R1(S), R2(S);
-        for (int s = 0; s < S; ++s) {
-          F[s].resize(N + 1, 3);
-          for (int k = 0; k <= N; ++k) {
-            const int g = problem.NodeOf(s, k);
-            F[s].row(k) = (ThrustVectorSmoothnessCost::ThrustAcceleration(problem.Control(g), problem.Quaternion(g), k_over_m) - gbar).transpose();
-          }
-          R0[s] = problem.SmoothnessMatrix(0, s, N + 1);
-          R1[s] = problem.SmoothnessMatrix(1, s, N + 1);
-          R2[s] = problem.SmoothnessMatrix(2, s, N + 1);
-          const Eigen::MatrixXd A0 = R0[s] * F[s], A2 = R2[s] * F[s];
-          for (int a = 0; a < 3; ++a) {
-            num[a] += -A2.col(a).dot(A0.col(a));
-            den[a] += A0.col(a).squaredNorm();
-          }
-        }
-        Eigen::Vector3d w2;
-        for (int a = 0; a < 3; ++a) w2[a] = std::clamp(den[a] > 0 ? num[a] / den[a] : 0.0, 0.0, options.thrust_oscillator_max * options.thrust_oscillator_max);
-        if (options.thrust_oscillator_isotropic) w2.setConstant(std::clamp(num.sum() / std::max(den.sum(), 1e-300), 0.0, options.thrust_oscillator_max * options.thrust_oscillator_max));
-        if (options.thrust_matern > 0) w2.setConstant(options.thrust_matern * options.thrust_matern);
-        if (options.thrust_matern_ml) {
-          // Type-II maximum likelihood of λ for (D + λ)² (f − ḡ) = white noise with σ per segment
-          // (profiled out): −log p = Σ_s (n_s/2) log E_s(λ) − λ T per axis + const (the λ part of
-          // ½ log det L*L is λ T for L = (D + λ)²), n_s = 3 N; E_s the energy of the current estimate,
-          // plus its posterior variance when there is one (EM).
-          const double T = problem.end_time() - problem.start_time();
-          double best = 0, best_nll = 1e300;
-          for (int i = 0; i <= 80; ++i) {
-            const double lambda = 0.1 * std::pow(100.0, i / 80.0);  // 0.1 .. 10 /s
-            double nll = -3.0 * lambda * T;
-            for (int s = 0; s < S; ++s) {
-              const Eigen::MatrixXd A = R2[s] + 2 * lambda * R1[s] + lambda * lambda * R0[s];
-              double e = (A * F[s]).squaredNorm();
-              if (!covf.empty()) e += variance(s, {A, A, A});
-              nll += 0.5 * 3.0 * N * std::log(e);
-            }
-            if (nll < best_nll) best_nll = nll, best = lambda;
-          }
-          w2.setConstant(best * best);
-        }
-        oscillator_lambda = (options.thrust_damping > 0 ? 1.0 : 0.0) * w2.cwiseSqrt();
-        if (std::getenv("CHEVAL_DEBUG_SIGMA")) std::fprintf(stderr, "em %d omega %.3f %.3f %.3f\n", em, std::sqrt(w2[0]), std::sqrt(w2[1]), std::sqrt(w2[2]));
-        if (oscillator_rows.empty()) {
-          for (auto* c : thrust_costs) c->set_weight(0.0);  // replaced by the oscillator rows
-          thrust_costs.clear();
-        }
-        for (int s = 0; s < S; ++s) {
-          std::vector<int> nodes;
-          for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(s, k));
-          std::array<Eigen::MatrixXd, 3> C;
-          Eigen::MatrixXd offsets(N + 1, 3);
-          for (int a = 0; a < 3; ++a) {
-            C[a] = R2[s] + w2[a] * R0[s] + 2 * options.thrust_damping * std::sqrt(w2[a]) * R1[s];
-            offsets.col(a) = -w2[a] * gbar[a] * R0[s].rowwise().sum();
-          }
-          if (static_cast<int>(oscillator_rows.size()) == S) {
-            thrust_costs[s]->set_rows(C, offsets);
-            oscillator_rows[s] = {C, offsets};
-            continue;
-          }
-          auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, C, offsets, k_over_m);
-          problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
-          thrust_costs.push_back(cost);
-          oscillator_rows.push_back({C, offsets});
+          num[a] -= A2.col(a).dot(A0.col(a));  // ∫ a'' a = −∫ |a'|² + ends
+          den[a] += A0.col(a).squaredNorm();
         }
       }
-      if (!thrust_costs.empty()) {
-        const int m = options.thrust_vector_prior_order;
-        const double floor_f = options.adaptive_rotor_prior_floor * vehicle.quadrotor.gravity_mps2 /
-                               vehicle.quadrotor.HoverRotorSpeed() * options.thrust_floor_factor;
-        std::vector<double> energy(S);
-        for (int s = 0; s < S; ++s) {
-          const Eigen::MatrixXd M = problem.SmoothnessMatrix(m, s);
-          Eigen::MatrixXd F(N + 1, 3);
-          for (int k = 0; k <= N; ++k) {
-            const int g = problem.NodeOf(s, k);
-            F.row(k) = ThrustVectorSmoothnessCost::ThrustAcceleration(problem.Control(g), problem.Quaternion(g), k_over_m)
-                           .transpose();
-          }
-          if (!oscillator_rows.empty()) {
-            double e = 0;
-            for (int a = 0; a < 3; ++a) e += (oscillator_rows[s].first[a] * F.col(a) + oscillator_rows[s].second.col(a)).squaredNorm();
-            energy[s] = e;
-            if (!covf.empty()) energy[s] += variance(s, oscillator_rows[s].first);
-          } else {
-            energy[s] = (M * F).squaredNorm();
-            if (!covf.empty()) energy[s] += variance(s, {M, M, M});
-          }
-        }
-        std::vector<double> sf(S);
-        for (int s = 0; s < S; ++s) {
-          double sum = 0;
-          int pooled = 0;
-          for (int n = std::max(s - options.thrust_pool, 0); n <= std::min(s + options.thrust_pool, S - 1); ++n, ++pooled) sum += energy[n];
-          sf[s] = std::max(floor_f, options.adaptive_scale * options.thrust_scale * std::sqrt(sum / (pooled * 3.0 * (N + 1 - m))));
-          thrust_costs[s]->set_weight(1.0 / sf[s]);
-          if (std::getenv("CHEVAL_DEBUG_SIGMA")) std::fprintf(stderr, "thrust segment %d sigma %.3f floor %.3f\n", s, sf[s], floor_f);
-        }
-        for (size_t j = 0; j < thrust_jumps.size(); ++j) thrust_jumps[j]->set_weight(1.0 / std::sqrt(sf[j] * sf[j + 1]));
-        if (options.thrust_stationary_start && oscillator_lambda.maxCoeff() > 0) {
-          // The proper (stationary) Matérn prior's initial state: a(t0) ~ N(0, σ²/(4λ³)), a'(t0) ~ N(0, σ²/(4λ))
-          // per axis, a = f − ḡ, σ the first segment's: with the forward energy of (D + λ)² a this is the
-          // exact density of the stationary process (time-symmetric); thrust_stationary_both: at t1 too.
-          const Eigen::Vector3d gbar(0, 0, vehicle.quadrotor.gravity_mps2);
-          for (int end = 0; end < (options.thrust_stationary_both ? 2 : 1); ++end) {
-            const int s = end == 0 ? 0 : S - 1;
-            const double sig = sf[s];
-            const detail::TimeRow row = problem.RowAt(end == 0 ? problem.start_time() : problem.end_time());
-            std::array<Eigen::MatrixXd, 3> C;
-            Eigen::MatrixXd offsets(2, 3);
-            for (int a = 0; a < 3; ++a) {
-              const double lambda = std::max(oscillator_lambda[a], 1e-3);
-              const double sd0 = sig / std::sqrt(4 * lambda * lambda * lambda), sd1 = sig / std::sqrt(4 * lambda);
-              C[a].resize(2, N + 1);
-              C[a].row(0) = row.w / sd0;
-              C[a].row(1) = row.dw / sd1;
-              offsets(0, a) = -gbar[a] / sd0;
-              offsets(1, a) = 0;
-            }
-            if (static_cast<int>(start_costs.size()) > end) {
-              start_costs[end]->set_rows(C, offsets);
-            } else {
-              std::vector<int> nodes;
-              for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(s, k));
-              auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, C, offsets, k_over_m);
-              problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
-              start_costs.push_back(cost);
-            }
-          }
-        }
-        // The collective's rotor-speed prior off, the differential ones as before.
-        for (int s = 0; s < S; ++s) {
-          Eigen::Vector4d e = Eigen::Vector4d::Zero();
-          int pooled = 0;
-          for (int n = std::max(s - 1, 0); n <= std::min(s + 1, S - 1); ++n, ++pooled) e += problem.ControlDerivativeEnergies(1, n, basis);
-          double sd = options.thrust_differential_own ? std::sqrt(e.tail<3>().sum() / (pooled * N * 3.0))
-                                                     : std::sqrt(e.sum() / (pooled * N * 4.0));
-          sd = std::max(options.adaptive_rotor_prior_floor, options.adaptive_scale * sd);
-          problem.SetControlSmoothnessSigmas(1, s, Eigen::Vector4d(options.thrust_keep_collective > 0 ? options.thrust_keep_collective * sd : 1e9, sd, sd, sd));
-        }
+      // λ_a: the root-mean-square frequency of the pilot's acceleration on axis a, sqrt(−∫a''a / ∫a²).
+      Eigen::Vector3d lambda;
+      for (int a = 0; a < 3; ++a) {
+        lambda[a] = std::sqrt(std::clamp(den[a] > 0 ? num[a] / den[a] : 0.0, 0.0,
+                                         options.thrust_prior_max_rate * options.thrust_prior_max_rate));
       }
-      if (em + 1 < options.em_iterations) {
-        solver.max_num_iterations = options.pilot_iterations;
-        summary = problem.Solve(solver);
-        iterations += static_cast<int>(summary.iterations.size()) - 1;
+      std::vector<std::array<Eigen::MatrixXd, 3>> rows(S);
+      std::vector<Eigen::MatrixXd> offsets(S);
+      std::vector<double> sigma_f(S);
+      for (int s = 0; s < S; ++s) {
+        offsets[s].resize(N + 1, 3);
+        double e = 0;
+        for (int a = 0; a < 3; ++a) {
+          rows[s][a] = Q2[s] + 2 * lambda[a] * Q1[s] + lambda[a] * lambda[a] * Q0[s];
+          offsets[s].col(a) = -lambda[a] * lambda[a] * gbar[a] * Q0[s].rowwise().sum();
+          e += (rows[s][a] * F[s].col(a)).squaredNorm();
+        }
+        // Maximum-likelihood intensity of the segment: 3 axes of N − 1 increments.
+        sigma_f[s] = std::max(std::sqrt(e / (3.0 * (N - 1))), 1e-9);
+        std::vector<int> nodes;
+        for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(s, k));
+        auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, rows[s], offsets[s], k_over_m);
+        cost->set_weight(1.0 / sigma_f[s]);
+        problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
       }
+      // f' continuous at the inner breakpoints (as AddControlSmoothnessPrior's jumps for m = 2).
+      for (int s = 0; s + 1 < S; ++s) {
+        std::vector<int> nodes;
+        for (int g = s * N; g <= (s + 2) * N; ++g) nodes.push_back(g);
+        auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, problem.SmoothnessJumpMatrix(2, s, 1.0), k_over_m);
+        cost->set_weight(1.0 / std::sqrt(sigma_f[s] * sigma_f[s + 1]));
+        problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
+      }
+      // The stationary process's first state, a(t0) ~ N(0, σ²/(4λ³)), a'(t0) ~ N(0, σ²/(4λ)) per axis:
+      // with the energy of (D + λ)² a above, the exact density of the stationary process.
+      const detail::TimeRow row = problem.RowAt(problem.start_time());
+      std::array<Eigen::MatrixXd, 3> C;
+      Eigen::MatrixXd o(2, 3);
+      for (int a = 0; a < 3; ++a) {
+        const double w0 = std::sqrt(4 * lambda[a] * lambda[a] * lambda[a]) / sigma_f[0];
+        const double w1 = std::sqrt(4 * lambda[a]) / sigma_f[0];
+        C[a].resize(2, N + 1);
+        C[a].row(0) = w0 * row.w;
+        C[a].row(1) = w1 * row.dw;
+        o(0, a) = -w0 * gbar[a];
+        o(1, a) = 0;
+      }
+      std::vector<int> nodes;
+      for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(0, k));
+      auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, C, o, k_over_m);
+      problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
     }
     solver.max_num_iterations = options.max_iterations;
     summary = problem.Solve(solver);

@@ -51,42 +51,17 @@ struct QuadrotorEstimateOptions {
   bool adaptive_rotor_prior = true;
   int pilot_iterations = 1;                ///< Levenberg–Marquardt iterations of the pilot solve (>= 1)
   double adaptive_rotor_prior_floor = 30;  ///< lower bound of the per-segment σ, rad/s² per s^(1/2) (> 0)
-  /// Experimental (docs/estimator.md, "What was tried"): a second prior ∫ |Ω''|² dt / σ₂² beside the
-  /// order-1 one, σ₂ this in the pilot (0 = none), per segment by the same empirical Bayes
-  /// (maximum-likelihood intensity over N − 1 increments) with `second_order_floor`.
-  double sigma_rotor_acceleration = 0;
-  double second_order_floor = 300;
-  /// Experimental: the prior on the collective (mean of the 4 rotors) and the 3 differential
-  /// (roll, pitch, yaw) rotor-speed combinations (an orthonormal basis), each with its own σ.
-  bool collective_split = false;
-  /// Experimental: EM instead of the plug-in intensity — the posterior variance of the pilot's rotor
-  /// rates (ceres::Covariance of each segment's rotor blocks) added to ∫|Ω̂'|²; `em_iterations` E/M
-  /// steps (each: covariance, σ update, `pilot_iterations` LM iterations) before the final solve.
-  bool posterior_variance = false;
-  int em_iterations = 1;
-  /// Experimental: the collective's prior on the world-frame thrust acceleration f = (k_F ΣΩ²/m) R e3,
-  /// ∫ |f^(m)|² dt / σ_f² with this m (0 = off; needs collective_split), σ_f per segment by empirical
-  /// Bayes; the collective rotor-speed prior then off (or × thrust_keep_collective if > 0).
-  int thrust_vector_prior_order = 0;
-  bool thrust_vector_jumps = true;
-  double thrust_floor_factor = 1.0;
-  bool thrust_differential_own = false;
-  double thrust_keep_collective = 0;
-  /// Experimental (with thrust_vector_prior_order 2): ∫ |f'' + ω_a² (f − ḡ)|² per axis a (ḡ the hover
-  /// thrust), ω_a² by least squares from the pilot, clamped to [0, thrust_oscillator_max²].
-  bool thrust_oscillator = false;
-  double thrust_damping = 0;  ///< experimental: ζ of the oscillator, L = D² + 2ζωD + ω²
-  double thrust_matern = 0;   ///< experimental: > 0: ω fixed to this (with ζ = 1: a Matérn-3/2 acceleration)
-  bool thrust_matern_ml = false;  ///< experimental: λ of the Matérn prior by type-II maximum likelihood
-  int thrust_pool = 1;  ///< experimental: the thrust σ pools segments s − this .. s + this
-  bool thrust_stationary_start = false;  ///< experimental: the stationary Matérn prior of the first state
-  bool thrust_stationary_both = false;   ///< experimental: ... and of the last
-  bool thrust_em = false;  ///< experimental: EM for the thrust σ (posterior variance from ceres::Covariance, em_iterations)
-  double thrust_scale = 1.0;  ///< experimental: a factor on the thrust prior's σ alone
-  bool thrust_oscillator_isotropic = false;
-  double thrust_oscillator_max = 6.0;
-  /// Experimental: a factor on every empirical-Bayes σ (1: the maximum-likelihood value).
-  double adaptive_scale = 1.0;
+  /// The collective rotor speed's prior on the world-frame thrust acceleration instead
+  /// (docs/estimator.md, "Defaults"; needs adaptive_rotor_prior): after the pilot, the collective
+  /// component of the rotor-rate prior is dropped and a = f − ḡ, f = (k_F ΣΩ²/m) R e3, ḡ the hover
+  /// thrust, gets ∫ |(D + λ_a)² a_a|² dt / σ_s² per axis a (a Matérn-3/2 process: a stationary
+  /// acceleration of correlation time 1/λ_a) with λ_a the root-mean-square frequency of the pilot's
+  /// a_a (sqrt(−∫a''a / ∫a²), at most thrust_prior_max_rate rad/s), σ_s the maximum-likelihood
+  /// intensity of segment s alone, f' continuous at the breakpoints, and the stationary law of
+  /// (a, a') at the first time (the exact density of the stationary process). The differential
+  /// (roll, pitch, yaw) components keep the random-walk prior with the per-segment σ above.
+  bool thrust_prior = true;
+  double thrust_prior_max_rate = 6.0;  ///< rad/s (> 0): the bound of λ_a on an axis without motion
   double huber_pixels = 3.0;  ///< Huber threshold on each landmark's whitened pixel error (in σ)
   /// Window of the flatness-based initialisation (FlatnessInitialState), s (> 0).
   double initial_window_s = 0.6;
