@@ -1,12 +1,14 @@
 // Measured figures of docs/estimator.md (a plain program: it prints tables, it does not assert).
 //   quadrotor_estimate [VEHICLE_JSON] [--seeds N] [--scaling]
-// 1. Every scenario x seeds 1..N (default 3): per-motor mean rotor-speed error (rpm, %), pose and
+// 1. Every scenario x seeds 1..N (default 3; --first-seed K: K..N): per-motor mean rotor-speed error (rpm, %), pose and
 //    velocity RMSE, states, iterations, seconds (one core).
 // 2. --scaling: figure-eight flights of 10 s .. 300 s at the default segment length: seconds per state.
 // Options (defaults: QuadrotorEstimateOptions): --duration S, --degree N, --segment S, --order M and
 // --sigma-u σ (rotor smoothness prior; the pilot's with the adaptive prior), --fixed-prior (σ_u
 // everywhere, no empirical Bayes), --floor σ and --pilot-iterations K (adaptive prior),
+// --no-thrust-prior (the collective's random-walk rotor prior instead of the thrust-acceleration one),
 // --sigma-p/-v/-w/-r σ (collocation), --trust-radius R, --window S (initialisation), --only SCENARIO,
+// --first-seed K (seeds K..N),
 // --full-report (Ceres' report of the final solve, with stage times), --dump PREFIX (writes
 // PREFIX_<scenario>_<seed>.txt: t, estimated rotor 0..3, true rotor 0..3).
 #include <cstdio>
@@ -57,6 +59,7 @@ Row Run(const estim::Vehicle& vehicle, sim::QuadrotorScenario scenario, uint64_t
 int main(int argc, char** argv) {
   std::string vehicle_path = CHEVAL_DEFAULT_VEHICLE;
   int seeds = 3;
+  int first_seed = 1;
   bool scaling = false;
   double duration = 10.0;
   std::string only, dump;
@@ -77,6 +80,8 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--fixed-prior")) options.adaptive_rotor_prior = false;
     else if (!std::strcmp(argv[i], "--floor") && i + 1 < argc) options.adaptive_rotor_prior_floor = std::stod(argv[++i]);
     else if (!std::strcmp(argv[i], "--pilot-iterations") && i + 1 < argc) options.pilot_iterations = std::stoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--no-thrust-prior")) options.thrust_prior = false;
+    else if (!std::strcmp(argv[i], "--first-seed") && i + 1 < argc) first_seed = std::stoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--full-report")) full_report = true;
     else if (!std::strcmp(argv[i], "--trust-radius") && i + 1 < argc) options.initial_trust_region_radius = std::stod(argv[++i]);
     else if (!std::strcmp(argv[i], "--window") && i + 1 < argc) options.initial_window_s = std::stod(argv[++i]);
@@ -91,7 +96,7 @@ int main(int argc, char** argv) {
     double worst = 0;
     for (sim::QuadrotorScenario scenario : sim::AllQuadrotorScenarios()) {
       if (!only.empty() && sim::ToString(scenario) != only) continue;
-      for (int seed = 1; seed <= seeds; ++seed) {
+      for (int seed = first_seed; seed <= seeds; ++seed) {
         const Row r = Run(vehicle, scenario, seed, duration, options, dump);
         const auto& e = r.errors;
         std::printf("%-11s %4d %6d %4d %7.3f | %7.2f %7.2f %7.2f %7.2f | %6.3f %6.3f %6.3f %6.3f | %8.4f %8.3f %8.4f%s\n",

@@ -3,6 +3,7 @@
 // paper's ω = φ' is wrong away from the chart origin), and control recovery of the unicycle.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <functional>
 #include <random>
 #include <vector>
@@ -444,6 +445,36 @@ TEST(PseudoSpectralProblem, SmoothnessPriorSigmaPerSegment) {
   EXPECT_THROW(problem.ControlDerivativeEnergy(0, 0), UsageError);
   PseudoSpectralProblem<UnicycleModel> bare(UnicycleModel{}, {0.0, 1.0}, 5);
   EXPECT_THROW(bare.SetControlSmoothnessSigma(0, 1.0), UsageError);  // no smoothness prior to re-weight
+}
+
+// In an orthonormal basis B of the controls (here a rotation by 30°) the prior is Σ_j ∫ |(Bᵀu)_j'|² /
+// σ_j²: ControlDerivativeEnergies splits ∫ |u'|² into the components' shares (they sum to the total),
+// and SetControlSmoothnessSigmas weights each; σ = ∞ drops a component. A basis that is not
+// orthonormal is rejected.
+TEST(PseudoSpectralProblem, SmoothnessPriorPerComponentOfABasis) {
+  const double sigma = 0.7, c = std::cos(M_PI / 6), s30 = std::sin(M_PI / 6);
+  Eigen::Matrix2d B;
+  B << c, -s30, s30, c;
+  PseudoSpectralProblem<UnicycleModel> problem(UnicycleModel{}, {0.0, 0.4, 1.1, 2.0}, 5);
+  for (int g = 0; g < problem.num_nodes(); ++g) {
+    const double t = problem.NodeTime(g);
+    problem.SetNode(g, Eigen::Vector4d::Zero(), Eigen::Matrix3d::Identity(), Eigen::Vector2d(t * t * t - 2 * t, 0.5 * t * t + 1));
+  }
+  problem.AddControlSmoothnessPrior(1, sigma, B);
+  double total = 0;
+  std::vector<Eigen::Vector2d> parts;
+  for (int s = 0; s < 3; ++s) {
+    parts.push_back(problem.ControlDerivativeEnergies(1, s, B));
+    EXPECT_NEAR(parts.back().sum(), problem.ControlDerivativeEnergy(1, s), 1e-12 * parts.back().sum()) << s;
+    total += parts.back().sum();
+  }
+  EXPECT_NEAR(TotalCost(problem.ceres_problem()), 0.5 * total / (sigma * sigma), 1e-12 * total);
+  problem.SetControlSmoothnessSigmas(1, 1, Eigen::Vector2d(2 * sigma, std::numeric_limits<double>::infinity()));
+  const double want = 0.5 * (parts[0].sum() + parts[2].sum() + parts[1][0] / 4) / (sigma * sigma);
+  EXPECT_NEAR(TotalCost(problem.ceres_problem()), want, 1e-12 * want);
+  ExpectJacobianMatchesDifferences(problem);
+  EXPECT_THROW(problem.AddControlSmoothnessPrior(1, sigma, Eigen::Matrix2d::Constant(1.0)), UsageError);
+  EXPECT_THROW(problem.SetControlSmoothnessSigmas(2, 0, Eigen::Vector2d(1, 1)), UsageError);  // no order-2 prior
 }
 
 }  // namespace

@@ -35,6 +35,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -273,20 +274,35 @@ class PseudoSpectralProblem {
   /// up to the integrated-Wiener constant, taken as 1), so the jump is held to what the prior allows
   /// across one node step. order in [1, min(3, N)], sigma > 0 (control units per s^m per s^(1/2)).
   void AddControlSmoothnessPrior(int order, double sigma) {
+    AddControlSmoothnessPrior(order, sigma, Eigen::Matrix<double, kControl, kControl>::Identity());
+  }
+
+  /// The same prior on the components c = Bᵀ u of the control in an orthonormal `basis` B (columns:
+  /// the components; e.g. the collective and differential rotor speeds), so that each component
+  /// can get its own σ (SetControlSmoothnessSigmas). With B = I it is the prior above. One prior per
+  /// order: adding an order again replaces its bookkeeping (the old residuals stay). Throws
+  /// UsageError for a basis that is not orthonormal (1e-9).
+  void AddControlSmoothnessPrior(int order, double sigma, const Eigen::Matrix<double, kControl, kControl>& basis) {
     if (order < 1 || order > std::min(3, degree_)) {
       throw UsageError(fmt::format("the control smoothness order must be in [1, {}], got {}", std::min(3, degree_), order));
     }
     if (!(sigma > 0)) throw UsageError("the control smoothness sigma must be > 0");
+    if (!(basis.transpose() * basis).isIdentity(1e-9)) throw UsageError("the control smoothness basis must be orthonormal");
     const int N = degree_;
-    smoothness_costs_.clear();
+    SmoothnessPrior& prior = smoothness_[order];
+    prior = SmoothnessPrior{};
+    prior.sigma = sigma;
+    prior.basis = basis;
+    prior.segment_sigma.assign(num_segments(), Eigen::Matrix<double, kControl, 1>::Constant(sigma));
     for (int s = 0; s < num_segments(); ++s) {
       std::vector<int> nodes;
       for (int k = 0; k <= N; ++k) nodes.push_back(NodeOf(s, k));
-      auto* cost = new LinearControlCost(this, nodes, SmoothnessRows(order, s));
+      auto* cost = new LinearControlCost(this, nodes, SmoothnessRows(order, s), basis);
       cost->set_weight(1.0 / sigma);
       problem_->AddResidualBlock(cost, nullptr, cost->blocks());
-      smoothness_costs_.push_back(cost);
+      prior.segments.push_back(cost);
     }
+    if (first_order_ == 0) first_order_ = order;
     // Continuity of u', ..., u^(m-1) at the inner breakpoints.
     const double h_unit = 1.0 - basis_.points()[1];  // shortest node spacing in x (at the ends)
     for (int s = 0; s + 1 < num_segments(); ++s) {
@@ -306,32 +322,78 @@ class PseudoSpectralProblem {
         }
       }
       if (order > 1) {
-        auto* cost = new LinearControlCost(this, nodes, coefficients);
+        auto* cost = new LinearControlCost(this, nodes, coefficients, basis);
         problem_->AddResidualBlock(cost, nullptr, cost->blocks());
+        prior.jumps.push_back(cost);
       }
     }
   }
 
   /// Replaces σ of segment s's integral ∫_s |u^(m)|² dt / σ² of AddControlSmoothnessPrior (which must
-  /// have been called; the jump residuals of m >= 2 keep the σ given there): a prior whose intensity
-  /// varies along the span (heteroscedastic). Takes effect at the next Solve. Throws UsageError for
-  /// sigma <= 0, a segment out of range or no smoothness prior.
+  /// have been called; the first order added): a prior whose intensity varies along the span
+  /// (heteroscedastic). For m >= 2 the jump residuals at the segment's breakpoints take the geometric
+  /// mean of the two segments' σ. Takes effect at the next Solve. Throws UsageError for sigma <= 0, a
+  /// segment out of range or no smoothness prior.
   void SetControlSmoothnessSigma(int s, double sigma) {
-    if (smoothness_costs_.empty()) throw UsageError("no control smoothness prior to re-weight");
+    if (first_order_ == 0) throw UsageError("no control smoothness prior to re-weight");
+    SetControlSmoothnessSigmas(first_order_, s, Eigen::Matrix<double, kControl, 1>::Constant(sigma));
+  }
+
+  /// σ per component (of the prior's basis) of segment s's integral of the order-m prior.
+  void SetControlSmoothnessSigmas(int order, int s, const Eigen::Matrix<double, kControl, 1>& sigma) {
+    auto it = smoothness_.find(order);
+    if (it == smoothness_.end()) throw UsageError("no control smoothness prior to re-weight");
     if (s < 0 || s >= num_segments()) throw UsageError(fmt::format("segment {} out of range [0, {})", s, num_segments()));
-    if (!(sigma > 0)) throw UsageError("the control smoothness sigma must be > 0");
-    smoothness_costs_[s]->set_weight(1.0 / sigma);
+    if (!(sigma.minCoeff() > 0)) throw UsageError("the control smoothness sigma must be > 0");
+    SmoothnessPrior& prior = it->second;
+    prior.segment_sigma[s] = sigma;
+    prior.segments[s]->set_weights(sigma.cwiseInverse());
+    for (int j = std::max(s - 1, 0); j <= std::min<int>(s, static_cast<int>(prior.jumps.size()) - 1); ++j) {
+      const Eigen::Matrix<double, kControl, 1> mean =
+          prior.segment_sigma[j].cwiseProduct(prior.segment_sigma[j + 1]).cwiseSqrt();
+      prior.jumps[j]->set_weights(prior.sigma * mean.cwiseInverse());
+    }
   }
 
   /// ∫ |u^(m)(t)|² dt over segment s of the current controls, summed over the control entries
   /// (exact: Gauss–Legendre with N − m + 1 points). order in [1, N]; UsageError otherwise.
   double ControlDerivativeEnergy(int order, int s) const {
+    return ControlDerivativeEnergies(order, s, Eigen::Matrix<double, kControl, kControl>::Identity()).sum();
+  }
+
+  /// The same per component c_j = B_jᵀ u of an orthonormal basis B (they sum to the total).
+  Eigen::Matrix<double, kControl, 1> ControlDerivativeEnergies(int order, int s,
+                                                               const Eigen::Matrix<double, kControl, kControl>& basis) const {
     if (order < 1 || order > degree_) throw UsageError(fmt::format("the derivative order must be in [1, {}]", degree_));
     if (s < 0 || s >= num_segments()) throw UsageError(fmt::format("segment {} out of range [0, {})", s, num_segments()));
     const Eigen::MatrixXd C = SmoothnessRows(order, s);
     Eigen::MatrixXd U(degree_ + 1, kControl);
     for (int k = 0; k <= degree_; ++k) U.row(k) = Eigen::Map<const Eigen::Matrix<double, 1, kControl>>(Control(NodeOf(s, k)));
-    return (C * U).squaredNorm();
+    return (C * U * basis).colwise().squaredNorm().transpose();
+  }
+
+  /// The rows of ∫_s |u^(m)|² dt (rows x N + 1 nodes of segment s, point order k = 0..N): the
+  /// energy of a control entry is |C U|².
+  Eigen::MatrixXd SmoothnessMatrix(int order, int s, int points = 0) const { return SmoothnessRows(order, s, points); }
+
+  /// The jump rows of the order-m prior with σ at the breakpoint between segments s and s + 1
+  /// (order − 1 rows over the global nodes s·N .. (s + 2)·N, in that order); empty for m = 1.
+  Eigen::MatrixXd SmoothnessJumpMatrix(int order, int s, double sigma) const {
+    const int N = degree_;
+    const double h_unit = 1.0 - basis_.points()[1];
+    const double scale_a = Interval(s).DerivativeScale(), scale_b = Interval(s + 1).DerivativeScale();
+    const double h = std::min(h_unit / scale_a, h_unit / scale_b);
+    Eigen::MatrixXd coefficients = Eigen::MatrixXd::Zero(order - 1, 2 * N + 1);
+    Eigen::MatrixXd Di = Eigen::MatrixXd::Identity(N + 1, N + 1);
+    for (int i = 1; i < order; ++i) {
+      Di = D_ * Di;
+      const double sigma_i = sigma * std::pow(h, order - i - 0.5);
+      for (int k = 0; k <= N; ++k) {
+        coefficients(i - 1, NodeOf(s, k) - s * N) += std::pow(scale_a, i) * Di(0, k) / sigma_i;
+        coefficients(i - 1, NodeOf(s + 1, k) - s * N) -= std::pow(scale_b, i) * Di(N, k) / sigma_i;
+      }
+    }
+    return coefficients;
   }
 
   /// Adds the measurement residual h(x(t)) at time t. `F` has
@@ -391,11 +453,11 @@ class PseudoSpectralProblem {
  private:
   // Rows sqrt(w_q L/2) u^(m)(t_q) over the controls of segment s in point order k = 0..N: their
   // squared sum is ∫_s |u^(m)|² dt, exactly (Gauss–Legendre with N − m + 1 points).
-  Eigen::MatrixXd SmoothnessRows(int order, int s) const {
+  Eigen::MatrixXd SmoothnessRows(int order, int s, int points = 0) const {
     const int N = degree_;
     Eigen::MatrixXd Dm = Eigen::MatrixXd::Identity(N + 1, N + 1);
     for (int i = 0; i < order; ++i) Dm = D_ * Dm;
-    const int nq = N - order + 1;
+    const int nq = points > 0 ? points : N - order + 1;
     Eigen::VectorXd xq, wq;
     detail::GaussLegendre(nq, &xq, &wq);
     Eigen::RowVectorXd row(N + 1);
@@ -617,34 +679,38 @@ class PseudoSpectralProblem {
     std::vector<double> coefficients_;
   };
 
-  // Rows C·U (C: rows x nodes) of the controls of the given nodes, the same for every control entry.
+  // Rows w_j (C·U·B)_{q j} (C: rows x nodes, U: nodes x controls, B: an orthonormal basis of the
+  // controls, w_j a weight per component), linear in the controls of the given nodes.
   class LinearControlCost : public ceres::CostFunction {
    public:
-    LinearControlCost(PseudoSpectralProblem* p, const std::vector<int>& nodes, Eigen::MatrixXd coefficients)
-        : coefficients_(std::move(coefficients)) {
+    LinearControlCost(PseudoSpectralProblem* p, const std::vector<int>& nodes, Eigen::MatrixXd coefficients,
+                      const Eigen::Matrix<double, kControl, kControl>& basis =
+                          Eigen::Matrix<double, kControl, kControl>::Identity())
+        : coefficients_(std::move(coefficients)), basis_(basis) {
       for (int g : nodes) {
         blocks_.push_back(p->Control(g));
         mutable_parameter_block_sizes()->push_back(kControl);
       }
       set_num_residuals(static_cast<int>(coefficients_.rows()) * kControl);
+      weights_.setOnes();
     }
     const std::vector<double*>& blocks() const { return blocks_; }
     /// A factor on every row (1/σ of a smoothness prior).
-    void set_weight(double weight) { weight_ = weight; }
+    void set_weight(double weight) { weights_.setConstant(weight); }
+    /// A factor per component (1/σ_j).
+    void set_weights(const Eigen::Matrix<double, kControl, 1>& weights) { weights_ = weights; }
     bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
       const int rows = static_cast<int>(coefficients_.rows());
+      const Eigen::Matrix<double, kControl, kControl> WB = basis_ * weights_.asDiagonal();  // u -> weighted components
       Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, kControl, Eigen::RowMajor>> r(residuals, rows, kControl);
       r.setZero();
       for (int k = 0; k < static_cast<int>(blocks_.size()); ++k) {
-        r += weight_ * coefficients_.col(k) * Eigen::Map<const Eigen::Matrix<double, 1, kControl>>(parameters[k]);
+        r += coefficients_.col(k) * (Eigen::Map<const Eigen::Matrix<double, 1, kControl>>(parameters[k]) * WB);
         if (jacobians && jacobians[k]) {
-          // Residual (q, i) depends on u_k[i] with coefficient C(q, k).
+          // Residual (q, j) depends on u_k[i] with coefficient C(q, k) (B W)(i, j).
           Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, kControl, Eigen::RowMajor>> J(jacobians[k], rows * kControl,
                                                                                          kControl);
-          J.setZero();
-          for (int q = 0; q < rows; ++q) {
-            for (int i = 0; i < kControl; ++i) J(q * kControl + i, i) = weight_ * coefficients_(q, k);
-          }
+          for (int q = 0; q < rows; ++q) J.template middleRows<kControl>(q * kControl) = coefficients_(q, k) * WB.transpose();
         }
       }
       return true;
@@ -653,7 +719,8 @@ class PseudoSpectralProblem {
    private:
     std::vector<double*> blocks_;
     Eigen::MatrixXd coefficients_;
-    double weight_ = 1.0;
+    Eigen::Matrix<double, kControl, kControl> basis_;
+    Eigen::Matrix<double, kControl, 1> weights_;
   };
 
   // h(x(t)): parameter blocks are the used vector blocks and the rotation of every node of the segment.
@@ -913,7 +980,15 @@ class PseudoSpectralProblem {
   std::vector<Eigen::Matrix3d> references_;
   std::vector<bool> manifold_set_;
   RightQuaternionManifold manifold_;
-  std::vector<LinearControlCost*> smoothness_costs_;  // per segment, owned by problem_
+  // A smoothness prior of one order: its residuals (owned by problem_) and σ per segment and component.
+  struct SmoothnessPrior {
+    double sigma = 0;  // the σ it was added with (the jump residuals' coefficients hold it)
+    Eigen::Matrix<double, kControl, kControl> basis = Eigen::Matrix<double, kControl, kControl>::Identity();
+    std::vector<LinearControlCost*> segments, jumps;
+    std::vector<Eigen::Matrix<double, kControl, 1>> segment_sigma;
+  };
+  std::map<int, SmoothnessPrior> smoothness_;
+  int first_order_ = 0;  // the order SetControlSmoothnessSigma re-weights
   std::unique_ptr<ceres::Problem> problem_;
 };
 

@@ -51,6 +51,17 @@ struct QuadrotorEstimateOptions {
   bool adaptive_rotor_prior = true;
   int pilot_iterations = 1;                ///< Levenberg–Marquardt iterations of the pilot solve (>= 1)
   double adaptive_rotor_prior_floor = 30;  ///< lower bound of the per-segment σ, rad/s² per s^(1/2) (> 0)
+  /// The collective rotor speed's prior on the world-frame thrust acceleration instead
+  /// (docs/estimator.md, "Defaults"; needs adaptive_rotor_prior): after the pilot, the collective
+  /// component of the rotor-rate prior is dropped and a = f − ḡ, f = (k_F ΣΩ²/m) R e3, ḡ the hover
+  /// thrust, gets ∫ |(D + λ_a)² a_a|² dt / σ_s² per axis a (a Matérn-3/2 process: a stationary
+  /// acceleration of correlation time 1/λ_a) with λ_a the root-mean-square frequency of the pilot's
+  /// a_a (sqrt(−∫a''a / ∫a²), at most thrust_prior_max_rate rad/s), σ_s the maximum-likelihood
+  /// intensity of segment s alone, f' continuous at the breakpoints, and the stationary law of
+  /// (a, a') at the first time (the exact density of the stationary process). The differential
+  /// (roll, pitch, yaw) components keep the random-walk prior with the per-segment σ above.
+  bool thrust_prior = true;
+  double thrust_prior_max_rate = 6.0;  ///< rad/s (> 0): the bound of λ_a on an axis without motion
   double huber_pixels = 3.0;  ///< Huber threshold on each landmark's whitened pixel error (in σ)
   /// Window of the flatness-based initialisation (FlatnessInitialState), s (> 0).
   double initial_window_s = 0.6;
