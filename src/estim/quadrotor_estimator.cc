@@ -127,6 +127,90 @@ std::vector<double> AdaptiveRotorPriorSigma(const std::vector<double>& energy, i
   return sigma;
 }
 
+namespace {
+
+// The collective rotor speed's prior after the pilot (QuadrotorEstimateOptions::thrust_prior,
+// docs/estimator.md "Defaults"): per world axis a, a Matérn-3/2 process on the thrust acceleration
+// a = (k_F ΣΩ²/m) R e3 − ḡ, ∫|(D + λ_a)² a_a|² dt / σ_s² per segment, with λ_a the pilot's
+// root-mean-square frequency on that axis, σ_s the maximum-likelihood intensity of segment s, the
+// rate of a continuous at the breakpoints and the stationary law of (a, a') at the first time.
+void AddThrustAccelerationPrior(Problem& problem, const Vehicle& vehicle, const QuadrotorEstimateOptions& options) {
+  const int S = problem.num_segments(), N = options.degree;
+  const double k_over_m = vehicle.quadrotor.thrust_coefficient / vehicle.quadrotor.mass_kg;
+  const Eigen::Vector3d gbar(0, 0, vehicle.quadrotor.gravity_mps2);
+  std::vector<Eigen::MatrixXd> F(S), Q0(S), Q1(S), Q2(S);  // pilot's f − ḡ at the nodes; GL rows of 1, D, D²
+  Eigen::Vector3d num = Eigen::Vector3d::Zero(), den = Eigen::Vector3d::Zero();
+  for (int s = 0; s < S; ++s) {
+    F[s].resize(N + 1, 3);
+    for (int k = 0; k <= N; ++k) {
+      const int g = problem.NodeOf(s, k);
+      F[s].row(k) = (ThrustVectorSmoothnessCost::ThrustAcceleration(problem.Control(g), problem.Quaternion(g), k_over_m) -
+                     gbar).transpose();
+    }
+    Q0[s] = problem.SmoothnessMatrix(0, s, N + 1);
+    Q1[s] = problem.SmoothnessMatrix(1, s, N + 1);
+    Q2[s] = problem.SmoothnessMatrix(2, s, N + 1);
+    const Eigen::MatrixXd A0 = Q0[s] * F[s], A2 = Q2[s] * F[s];
+    for (int a = 0; a < 3; ++a) {
+      num[a] -= A2.col(a).dot(A0.col(a));  // ∫ a'' a = −∫ |a'|² + ends
+      den[a] += A0.col(a).squaredNorm();
+    }
+  }
+  // λ_a: the root-mean-square frequency of the pilot's acceleration on axis a, sqrt(−∫a''a / ∫a²).
+  Eigen::Vector3d lambda;
+  for (int a = 0; a < 3; ++a) {
+    lambda[a] = std::sqrt(std::clamp(den[a] > 0 ? num[a] / den[a] : 0.0, 0.0,
+                                     options.thrust_prior_max_rate * options.thrust_prior_max_rate));
+  }
+  std::vector<std::array<Eigen::MatrixXd, 3>> rows(S);
+  std::vector<Eigen::MatrixXd> offsets(S);
+  std::vector<double> sigma_f(S);
+  for (int s = 0; s < S; ++s) {
+    offsets[s].resize(N + 1, 3);
+    double e = 0;
+    for (int a = 0; a < 3; ++a) {
+      rows[s][a] = Q2[s] + 2 * lambda[a] * Q1[s] + lambda[a] * lambda[a] * Q0[s];
+      offsets[s].col(a) = -lambda[a] * lambda[a] * gbar[a] * Q0[s].rowwise().sum();
+      e += (rows[s][a] * F[s].col(a)).squaredNorm();
+    }
+    // Maximum-likelihood intensity of the segment: 3 axes of N − 1 increments.
+    sigma_f[s] = std::max(std::sqrt(e / (3.0 * (N - 1))), 1e-9);
+    std::vector<int> nodes;
+    for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(s, k));
+    auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, rows[s], offsets[s], k_over_m);
+    cost->set_weight(1.0 / sigma_f[s]);
+    problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
+  }
+  // f' continuous at the inner breakpoints (as AddControlSmoothnessPrior's jumps for m = 2).
+  for (int s = 0; s + 1 < S; ++s) {
+    std::vector<int> nodes;
+    for (int g = s * N; g <= (s + 2) * N; ++g) nodes.push_back(g);
+    auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, problem.SmoothnessJumpMatrix(2, s, 1.0), k_over_m);
+    cost->set_weight(1.0 / std::sqrt(sigma_f[s] * sigma_f[s + 1]));
+    problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
+  }
+  // The stationary process's first state, a(t0) ~ N(0, σ²/(4λ³)), a'(t0) ~ N(0, σ²/(4λ)) per axis:
+  // with the energy of (D + λ)² a above, the exact density of the stationary process.
+  const detail::TimeRow row = problem.RowAt(problem.start_time());
+  std::array<Eigen::MatrixXd, 3> C;
+  Eigen::MatrixXd o(2, 3);
+  for (int a = 0; a < 3; ++a) {
+    const double w0 = std::sqrt(4 * lambda[a] * lambda[a] * lambda[a]) / sigma_f[0];
+    const double w1 = std::sqrt(4 * lambda[a]) / sigma_f[0];
+    C[a].resize(2, N + 1);
+    C[a].row(0) = w0 * row.w;
+    C[a].row(1) = w1 * row.dw;
+    o(0, a) = -w0 * gbar[a];
+    o(1, a) = 0;
+  }
+  std::vector<int> nodes;
+  for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(0, k));
+  auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, C, o, k_over_m);
+  problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
+}
+
+}  // namespace
+
 QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Eigen::Vector3d>& landmarks,
                                     const std::vector<PixelObservation>& pixels,
                                     const std::vector<PoseSample>& initial, const QuadrotorEstimateOptions& options,
@@ -235,7 +319,7 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   ceres::Solver::Summary summary = problem.Solve(solver);
   int iterations = static_cast<int>(summary.iterations.size()) - 1;
   if (adaptive) {  // empirical Bayes: σ per segment from the pilot's rotor speeds, then the solve
-    const int S = problem.num_segments(), N = options.degree;
+    const int S = problem.num_segments();
     std::vector<double> energy(S);
     for (int s = 0; s < S; ++s) energy[s] = problem.ControlDerivativeEnergy(1, s);
     const std::vector<double> segment_sigma = AdaptiveRotorPriorSigma(energy, options.degree, QuadrotorModel::kControlDim);
@@ -245,79 +329,7 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
       const double sigma_s = std::max(options.adaptive_rotor_prior_floor, segment_sigma[s]);
       problem.SetControlSmoothnessSigmas(1, s, Eigen::Vector4d(thrust ? off : sigma_s, sigma_s, sigma_s, sigma_s));
     }
-    if (thrust) {  // the collective's prior: a Matérn process on the thrust acceleration (docs/estimator.md)
-      const double k_over_m = vehicle.quadrotor.thrust_coefficient / vehicle.quadrotor.mass_kg;
-      const Eigen::Vector3d gbar(0, 0, vehicle.quadrotor.gravity_mps2);
-      std::vector<Eigen::MatrixXd> F(S), Q0(S), Q1(S), Q2(S);  // pilot's f − ḡ at the nodes; GL rows of 1, D, D²
-      Eigen::Vector3d num = Eigen::Vector3d::Zero(), den = Eigen::Vector3d::Zero();
-      for (int s = 0; s < S; ++s) {
-        F[s].resize(N + 1, 3);
-        for (int k = 0; k <= N; ++k) {
-          const int g = problem.NodeOf(s, k);
-          F[s].row(k) = (ThrustVectorSmoothnessCost::ThrustAcceleration(problem.Control(g), problem.Quaternion(g), k_over_m) -
-                         gbar).transpose();
-        }
-        Q0[s] = problem.SmoothnessMatrix(0, s, N + 1);
-        Q1[s] = problem.SmoothnessMatrix(1, s, N + 1);
-        Q2[s] = problem.SmoothnessMatrix(2, s, N + 1);
-        const Eigen::MatrixXd A0 = Q0[s] * F[s], A2 = Q2[s] * F[s];
-        for (int a = 0; a < 3; ++a) {
-          num[a] -= A2.col(a).dot(A0.col(a));  // ∫ a'' a = −∫ |a'|² + ends
-          den[a] += A0.col(a).squaredNorm();
-        }
-      }
-      // λ_a: the root-mean-square frequency of the pilot's acceleration on axis a, sqrt(−∫a''a / ∫a²).
-      Eigen::Vector3d lambda;
-      for (int a = 0; a < 3; ++a) {
-        lambda[a] = std::sqrt(std::clamp(den[a] > 0 ? num[a] / den[a] : 0.0, 0.0,
-                                         options.thrust_prior_max_rate * options.thrust_prior_max_rate));
-      }
-      std::vector<std::array<Eigen::MatrixXd, 3>> rows(S);
-      std::vector<Eigen::MatrixXd> offsets(S);
-      std::vector<double> sigma_f(S);
-      for (int s = 0; s < S; ++s) {
-        offsets[s].resize(N + 1, 3);
-        double e = 0;
-        for (int a = 0; a < 3; ++a) {
-          rows[s][a] = Q2[s] + 2 * lambda[a] * Q1[s] + lambda[a] * lambda[a] * Q0[s];
-          offsets[s].col(a) = -lambda[a] * lambda[a] * gbar[a] * Q0[s].rowwise().sum();
-          e += (rows[s][a] * F[s].col(a)).squaredNorm();
-        }
-        // Maximum-likelihood intensity of the segment: 3 axes of N − 1 increments.
-        sigma_f[s] = std::max(std::sqrt(e / (3.0 * (N - 1))), 1e-9);
-        std::vector<int> nodes;
-        for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(s, k));
-        auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, rows[s], offsets[s], k_over_m);
-        cost->set_weight(1.0 / sigma_f[s]);
-        problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
-      }
-      // f' continuous at the inner breakpoints (as AddControlSmoothnessPrior's jumps for m = 2).
-      for (int s = 0; s + 1 < S; ++s) {
-        std::vector<int> nodes;
-        for (int g = s * N; g <= (s + 2) * N; ++g) nodes.push_back(g);
-        auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, problem.SmoothnessJumpMatrix(2, s, 1.0), k_over_m);
-        cost->set_weight(1.0 / std::sqrt(sigma_f[s] * sigma_f[s + 1]));
-        problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
-      }
-      // The stationary process's first state, a(t0) ~ N(0, σ²/(4λ³)), a'(t0) ~ N(0, σ²/(4λ)) per axis:
-      // with the energy of (D + λ)² a above, the exact density of the stationary process.
-      const detail::TimeRow row = problem.RowAt(problem.start_time());
-      std::array<Eigen::MatrixXd, 3> C;
-      Eigen::MatrixXd o(2, 3);
-      for (int a = 0; a < 3; ++a) {
-        const double w0 = std::sqrt(4 * lambda[a] * lambda[a] * lambda[a]) / sigma_f[0];
-        const double w1 = std::sqrt(4 * lambda[a]) / sigma_f[0];
-        C[a].resize(2, N + 1);
-        C[a].row(0) = w0 * row.w;
-        C[a].row(1) = w1 * row.dw;
-        o(0, a) = -w0 * gbar[a];
-        o(1, a) = 0;
-      }
-      std::vector<int> nodes;
-      for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(0, k));
-      auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, C, o, k_over_m);
-      problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
-    }
+    if (thrust) AddThrustAccelerationPrior(problem, vehicle, options);
     solver.max_num_iterations = options.max_iterations;
     summary = problem.Solve(solver);
     iterations += static_cast<int>(summary.iterations.size()) - 1;
