@@ -8,9 +8,11 @@
 // everywhere, no empirical Bayes), --floor σ and --pilot-iterations K (adaptive prior),
 // --no-thrust-prior (the collective's random-walk rotor prior instead of the thrust-acceleration one),
 // --sigma-p/-v/-w/-r σ (collocation), --trust-radius R, --window S (initialisation), --only SCENARIO,
-// --first-seed K (seeds K..N),
+// --first-seed K (seeds K..N), --thrust-rounds K, --thrust-order M, --motion-prior (variants of the thrust prior),
+// --max-iterations K, --ftol / --gtol / --ptol X (Ceres' tolerances),
 // --full-report (Ceres' report of the final solve, with stage times), --dump PREFIX (writes
-// PREFIX_<scenario>_<seed>.txt: t, estimated rotor 0..3, true rotor 0..3).
+// PREFIX_<scenario>_<seed>.txt: t, estimated rotor 0..3, true rotor 0..3,
+// estimated and true quaternion w x y z).
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -46,8 +48,10 @@ Row Run(const estim::Vehicle& vehicle, sim::QuadrotorScenario scenario, uint64_t
     for (size_t i = 0; i < row.estimate.samples.size() && i < data.truth.size(); ++i) {
       const auto& e = row.estimate.samples[i];
       const auto& g = data.truth[i];
-      std::fprintf(f, "%.3f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %.3f\n", e.t, e.rotor[0], e.rotor[1], e.rotor[2],
-                   e.rotor[3], g.rotor[0], g.rotor[1], g.rotor[2], g.rotor[3]);
+      const Eigen::Quaterniond qe(e.R);
+      std::fprintf(f, "%.3f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", e.t,
+                   e.rotor[0], e.rotor[1], e.rotor[2], e.rotor[3], g.rotor[0], g.rotor[1], g.rotor[2], g.rotor[3],
+                   qe.w(), qe.x(), qe.y(), qe.z(), g.q.w(), g.q.x(), g.q.y(), g.q.z());
     }
     std::fclose(f);
   }
@@ -81,6 +85,13 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--floor") && i + 1 < argc) options.adaptive_rotor_prior_floor = std::stod(argv[++i]);
     else if (!std::strcmp(argv[i], "--pilot-iterations") && i + 1 < argc) options.pilot_iterations = std::stoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--no-thrust-prior")) options.thrust_prior = false;
+    else if (!std::strcmp(argv[i], "--thrust-rounds") && i + 1 < argc) options.thrust_prior_rounds = std::stoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--thrust-order") && i + 1 < argc) options.thrust_prior_order = std::stoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--motion-prior")) options.motion_prior = true;
+    else if (!std::strcmp(argv[i], "--max-iterations") && i + 1 < argc) options.max_iterations = std::stoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--ftol") && i + 1 < argc) options.function_tolerance = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--gtol") && i + 1 < argc) options.gradient_tolerance = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--ptol") && i + 1 < argc) options.parameter_tolerance = std::stod(argv[++i]);
     else if (!std::strcmp(argv[i], "--first-seed") && i + 1 < argc) first_seed = std::stoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--full-report")) full_report = true;
     else if (!std::strcmp(argv[i], "--trust-radius") && i + 1 < argc) options.initial_trust_region_radius = std::stod(argv[++i]);

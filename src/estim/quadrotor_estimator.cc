@@ -10,6 +10,7 @@
 
 #include <Eigen/Dense>
 
+#include "cheval/cheb/chebyshev.h"
 #include "cheval/common/error.h"
 #include "cheval/estim/problem.h"
 #include "cheval/estim/thrust_vector_prior.h"
@@ -129,16 +130,145 @@ std::vector<double> AdaptiveRotorPriorSigma(const std::vector<double>& energy, i
 
 namespace {
 
+// Rows C_a V_a (axis a = x, y, z) of the velocities V_a of the given nodes (their velocity blocks):
+// linear, so the Jacobian is constant. With C_a the Gauss–Legendre rows of (D + λ_a)² D over a
+// segment, the squared sum is ∫_s |(D + λ_a)² v_a'|² dt exactly.
+class VelocityRowsCost : public ceres::CostFunction {
+ public:
+  VelocityRowsCost(Problem& p, const std::vector<int>& nodes, std::array<Eigen::MatrixXd, 3> coefficients)
+      : coefficients_(std::move(coefficients)) {
+    for (int g : nodes) {
+      blocks_.push_back(p.Vector(g) + 3);
+      mutable_parameter_block_sizes()->push_back(3);
+    }
+    set_num_residuals(3 * static_cast<int>(coefficients_[0].rows()));
+  }
+  const std::vector<double*>& blocks() const { return blocks_; }
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const int rows = static_cast<int>(coefficients_[0].rows()), n = static_cast<int>(blocks_.size());
+    for (int a = 0; a < 3; ++a) {
+      for (int q = 0; q < rows; ++q) {
+        double r = 0;
+        for (int k = 0; k < n; ++k) r += coefficients_[a](q, k) * parameters[k][a];
+        residuals[a * rows + q] = r;
+      }
+    }
+    if (jacobians) {
+      for (int k = 0; k < n; ++k) {
+        if (!jacobians[k]) continue;
+        Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> J(jacobians[k], 3 * rows, 3);
+        J.setZero();
+        for (int a = 0; a < 3; ++a) {
+          for (int q = 0; q < rows; ++q) J(a * rows + q, a) = coefficients_[a](q, k);
+        }
+      }
+    }
+    return true;
+  }
+
+ private:
+  std::array<Eigen::MatrixXd, 3> coefficients_;
+  std::vector<double*> blocks_;
+};
+
+// The kinematic acceleration's prior (QuadrotorEstimateOptions::motion_prior): per world axis a, a
+// Matérn-3/2 process on v_a', ∫ |(D + λ_a)² v_a'|² dt / σ_s² per segment, λ_a and σ_s from the
+// pilot as in AddThrustAccelerationPrior, v' and v'' continuous at the breakpoints and the
+// stationary law of (v', v'') at the first time. The collective rotor speed then follows from
+// the collocation of v' = f − g − drag.
+std::vector<ceres::ResidualBlockId> AddMotionPrior(Problem& problem, const QuadrotorEstimateOptions& options) {
+  std::vector<ceres::ResidualBlockId> ids;
+  const int S = problem.num_segments(), N = options.degree;
+  std::vector<Eigen::MatrixXd> V(S);
+  const int m = options.thrust_prior_order;  // 2: Matérn-3/2 on v', 3: Matérn-5/2
+  std::vector<std::array<Eigen::MatrixXd, 5>> Q(S);  // GL rows of the 1st .. 4th derivatives of v
+  Eigen::Vector3d num = Eigen::Vector3d::Zero(), den = Eigen::Vector3d::Zero();
+  for (int s = 0; s < S; ++s) {
+    V[s].resize(N + 1, 3);
+    for (int k = 0; k <= N; ++k) {
+      V[s].row(k) = Eigen::Map<const Eigen::Vector3d>(problem.Vector(problem.NodeOf(s, k)) + 3).transpose();
+    }
+    for (int j = 1; j <= m + 1; ++j) Q[s][j] = problem.SmoothnessMatrix(j, s, N + 1);
+    const Eigen::MatrixXd A0 = Q[s][1] * V[s], A2 = Q[s][3] * V[s];
+    for (int a = 0; a < 3; ++a) {
+      num[a] -= A2.col(a).dot(A0.col(a));
+      den[a] += A0.col(a).squaredNorm();
+    }
+  }
+  Eigen::Vector3d lambda;
+  const double rms_to_lambda = m == 3 ? std::sqrt(3.0) : 1.0;
+  for (int a = 0; a < 3; ++a) {
+    lambda[a] = rms_to_lambda * std::sqrt(std::clamp(den[a] > 0 ? num[a] / den[a] : 0.0, 0.0,
+                                     options.thrust_prior_max_rate * options.thrust_prior_max_rate));
+  }
+  std::vector<std::array<Eigen::MatrixXd, 3>> rows(S);
+  std::vector<double> sigma_f(S);
+  for (int s = 0; s < S; ++s) {
+    double e = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double l = lambda[a];
+      rows[s][a] = m == 2 ? Eigen::MatrixXd(Q[s][3] + 2 * l * Q[s][2] + l * l * Q[s][1])
+                          : Eigen::MatrixXd(Q[s][4] + 3 * l * Q[s][3] + 3 * l * l * Q[s][2] + l * l * l * Q[s][1]);
+      e += (rows[s][a] * V[s].col(a)).squaredNorm();
+    }
+    sigma_f[s] = std::max(std::sqrt(e / (3.0 * (N + 1 - m))), 1e-9);
+  }
+  for (int s = 0; s < S; ++s) {
+    std::vector<int> nodes;
+    for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(s, k));
+    std::array<Eigen::MatrixXd, 3> r;
+    for (int a = 0; a < 3; ++a) r[a] = rows[s][a] / sigma_f[s];
+    auto* cost = new VelocityRowsCost(problem, nodes, r);
+    ids.push_back(problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks()));
+  }
+  for (int s = 0; s + 1 < S; ++s) {  // v' and v'' continuous at the inner breakpoints
+    std::vector<int> nodes;
+    for (int g = s * N; g <= (s + 2) * N; ++g) nodes.push_back(g);
+    const Eigen::MatrixXd J = problem.SmoothnessJumpMatrix(m + 1, s, std::sqrt(sigma_f[s] * sigma_f[s + 1]));
+    auto* cost = new VelocityRowsCost(problem, nodes, {J, J, J});
+    ids.push_back(problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks()));
+  }
+  const detail::TimeRow row = problem.RowAt(problem.start_time());
+  const Eigen::MatrixXd D = cheb::DifferentiationMatrix(N);
+  const double scale = 2.0 / (problem.breakpoints()[1] - problem.breakpoints()[0]);
+  Eigen::MatrixXd R0(m, N + 1);  // rows of v', v'', v''' at t0
+  R0.row(0) = row.dw;
+  for (int i = 1; i < m; ++i) R0.row(i) = scale * R0.row(i - 1) * D;
+  std::array<Eigen::MatrixXd, 3> C;
+  for (int a = 0; a < 3; ++a) {
+    const double l = lambda[a];
+    Eigen::MatrixXd cov(m, m);
+    if (m == 2) {
+      cov << 1 / (4 * l * l * l), 0, 0, 1 / (4 * l);
+    } else {
+      cov << 3, 0, -l * l, 0, l * l, 0, -l * l, 0, 3 * l * l * l * l;
+      cov /= 16 * std::pow(l, 5);
+    }
+    cov *= sigma_f[0] * sigma_f[0];
+    const Eigen::MatrixXd info = cov.inverse();
+    C[a] = Eigen::LLT<Eigen::MatrixXd>(info).matrixL().transpose() * R0;
+  }
+  std::vector<int> nodes;
+  for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(0, k));
+  auto* cost = new VelocityRowsCost(problem, nodes, C);
+  ids.push_back(problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks()));
+  return ids;
+}
+
 // The collective rotor speed's prior after the pilot (QuadrotorEstimateOptions::thrust_prior,
 // docs/estimator.md "Defaults"): per world axis a, a Matérn-3/2 process on the thrust acceleration
 // a = (k_F ΣΩ²/m) R e3 − ḡ, ∫|(D + λ_a)² a_a|² dt / σ_s² per segment, with λ_a the pilot's
 // root-mean-square frequency on that axis, σ_s the maximum-likelihood intensity of segment s, the
 // rate of a continuous at the breakpoints and the stationary law of (a, a') at the first time.
-void AddThrustAccelerationPrior(Problem& problem, const Vehicle& vehicle, const QuadrotorEstimateOptions& options) {
+std::vector<ceres::ResidualBlockId> AddThrustAccelerationPrior(Problem& problem, const Vehicle& vehicle,
+                                                               const QuadrotorEstimateOptions& options) {
+  std::vector<ceres::ResidualBlockId> ids;
   const int S = problem.num_segments(), N = options.degree;
   const double k_over_m = vehicle.quadrotor.thrust_coefficient / vehicle.quadrotor.mass_kg;
   const Eigen::Vector3d gbar(0, 0, vehicle.quadrotor.gravity_mps2);
-  std::vector<Eigen::MatrixXd> F(S), Q0(S), Q1(S), Q2(S);  // pilot's f − ḡ at the nodes; GL rows of 1, D, D²
+  const int m = options.thrust_prior_order;  // 2: Matérn-3/2, (D + λ)² a; 3: Matérn-5/2, (D + λ)³ a
+  std::vector<Eigen::MatrixXd> F(S);  // pilot's f − ḡ at the nodes
+  std::vector<std::array<Eigen::MatrixXd, 4>> Q(S);  // GL rows of 1, D, D², D³
   Eigen::Vector3d num = Eigen::Vector3d::Zero(), den = Eigen::Vector3d::Zero();
   for (int s = 0; s < S; ++s) {
     F[s].resize(N + 1, 3);
@@ -147,66 +277,87 @@ void AddThrustAccelerationPrior(Problem& problem, const Vehicle& vehicle, const 
       F[s].row(k) = (ThrustVectorSmoothnessCost::ThrustAcceleration(problem.Control(g), problem.Quaternion(g), k_over_m) -
                      gbar).transpose();
     }
-    Q0[s] = problem.SmoothnessMatrix(0, s, N + 1);
-    Q1[s] = problem.SmoothnessMatrix(1, s, N + 1);
-    Q2[s] = problem.SmoothnessMatrix(2, s, N + 1);
-    const Eigen::MatrixXd A0 = Q0[s] * F[s], A2 = Q2[s] * F[s];
+    for (int j = 0; j <= m; ++j) Q[s][j] = problem.SmoothnessMatrix(j, s, N + 1);
+    const Eigen::MatrixXd A0 = Q[s][0] * F[s], A2 = Q[s][2] * F[s];
     for (int a = 0; a < 3; ++a) {
       num[a] -= A2.col(a).dot(A0.col(a));  // ∫ a'' a = −∫ |a'|² + ends
       den[a] += A0.col(a).squaredNorm();
     }
   }
-  // λ_a: the root-mean-square frequency of the pilot's acceleration on axis a, sqrt(−∫a''a / ∫a²).
+  // λ_a: matched to the root-mean-square frequency ν of the pilot's acceleration on axis a,
+  // ν = sqrt(−∫a''a / ∫a²): a Matérn-3/2 process has ν = λ, a Matérn-5/2 one ν = λ/√3.
   Eigen::Vector3d lambda;
+  const double rms_to_lambda = m == 3 ? std::sqrt(3.0) : 1.0;
   for (int a = 0; a < 3; ++a) {
-    lambda[a] = std::sqrt(std::clamp(den[a] > 0 ? num[a] / den[a] : 0.0, 0.0,
-                                     options.thrust_prior_max_rate * options.thrust_prior_max_rate));
+    lambda[a] = rms_to_lambda * std::sqrt(std::clamp(den[a] > 0 ? num[a] / den[a] : 0.0, 0.0,
+                                                     options.thrust_prior_max_rate * options.thrust_prior_max_rate));
   }
   std::vector<std::array<Eigen::MatrixXd, 3>> rows(S);
   std::vector<Eigen::MatrixXd> offsets(S);
   std::vector<double> sigma_f(S);
+  const double binomial[4][4] = {{1, 0, 0, 0}, {1, 1, 0, 0}, {1, 2, 1, 0}, {1, 3, 3, 1}};
   for (int s = 0; s < S; ++s) {
     offsets[s].resize(N + 1, 3);
     double e = 0;
     for (int a = 0; a < 3; ++a) {
-      rows[s][a] = Q2[s] + 2 * lambda[a] * Q1[s] + lambda[a] * lambda[a] * Q0[s];
-      offsets[s].col(a) = -lambda[a] * lambda[a] * gbar[a] * Q0[s].rowwise().sum();
+      rows[s][a] = Eigen::MatrixXd::Zero(N + 1, N + 1);
+      for (int j = 0; j <= m; ++j) rows[s][a] += binomial[m][j] * std::pow(lambda[a], m - j) * Q[s][j];
+      offsets[s].col(a) = -std::pow(lambda[a], m) * gbar[a] * Q[s][0].rowwise().sum();
       e += (rows[s][a] * F[s].col(a)).squaredNorm();
     }
-    // Maximum-likelihood intensity of the segment: 3 axes of N − 1 increments.
-    sigma_f[s] = std::max(std::sqrt(e / (3.0 * (N - 1))), 1e-9);
+    // Maximum-likelihood intensity of the segment: 3 axes of N + 1 − m increments.
+    sigma_f[s] = std::max(std::sqrt(e / (3.0 * (N + 1 - m))), 1e-9);
+  }
+  for (int s = 0; s < S; ++s) {
     std::vector<int> nodes;
     for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(s, k));
     auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, rows[s], offsets[s], k_over_m);
     cost->set_weight(1.0 / sigma_f[s]);
-    problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
+    ids.push_back(problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks()));
   }
-  // f' continuous at the inner breakpoints (as AddControlSmoothnessPrior's jumps for m = 2).
+  // f' (and f'' for m = 3) continuous at the inner breakpoints (as AddControlSmoothnessPrior's jumps).
   for (int s = 0; s + 1 < S; ++s) {
     std::vector<int> nodes;
     for (int g = s * N; g <= (s + 2) * N; ++g) nodes.push_back(g);
-    auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, problem.SmoothnessJumpMatrix(2, s, 1.0), k_over_m);
+    auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, problem.SmoothnessJumpMatrix(m, s, 1.0), k_over_m);
     cost->set_weight(1.0 / std::sqrt(sigma_f[s] * sigma_f[s + 1]));
-    problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
+    ids.push_back(problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks()));
   }
-  // The stationary process's first state, a(t0) ~ N(0, σ²/(4λ³)), a'(t0) ~ N(0, σ²/(4λ)) per axis:
-  // with the energy of (D + λ)² a above, the exact density of the stationary process.
+  // The stationary process's first state (a, a', .., a^(m−1)) at t0: with the energy of (D + λ)^m a
+  // above, the exact density of the stationary process. Its covariance per axis, from the spectrum
+  // σ² / (λ² + ω²)^m: m = 2: diag(1/(4λ³), 1/(4λ)) σ²; m = 3: [[3, 0, −λ²], [0, λ², 0],
+  // [−λ², 0, 3λ⁴]] σ² / (16λ⁵).
   const detail::TimeRow row = problem.RowAt(problem.start_time());
+  Eigen::MatrixXd R0(m, N + 1);  // rows of a, a', a'' at t0 in the first segment's point order
+  R0.row(0) = row.w;
+  R0.row(1) = row.dw;
+  if (m == 3) {
+    const Eigen::MatrixXd D = cheb::DifferentiationMatrix(N);
+    const double scale = 2.0 / (problem.breakpoints()[1] - problem.breakpoints()[0]);
+    R0.row(2) = scale * row.dw * D;
+  }
   std::array<Eigen::MatrixXd, 3> C;
-  Eigen::MatrixXd o(2, 3);
+  Eigen::MatrixXd o(m, 3);
   for (int a = 0; a < 3; ++a) {
-    const double w0 = std::sqrt(4 * lambda[a] * lambda[a] * lambda[a]) / sigma_f[0];
-    const double w1 = std::sqrt(4 * lambda[a]) / sigma_f[0];
-    C[a].resize(2, N + 1);
-    C[a].row(0) = w0 * row.w;
-    C[a].row(1) = w1 * row.dw;
-    o(0, a) = -w0 * gbar[a];
-    o(1, a) = 0;
+    const double l = lambda[a];
+    Eigen::MatrixXd cov(m, m);
+    if (m == 2) {
+      cov << 1 / (4 * l * l * l), 0, 0, 1 / (4 * l);
+    } else {
+      cov << 3, 0, -l * l, 0, l * l, 0, -l * l, 0, 3 * l * l * l * l;
+      cov /= 16 * std::pow(l, 5);
+    }
+    cov *= sigma_f[0] * sigma_f[0];
+    const Eigen::MatrixXd info = cov.inverse();
+    const Eigen::MatrixXd W = Eigen::LLT<Eigen::MatrixXd>(info).matrixL().transpose();  // |W x|² = xᵀ info x
+    C[a] = W * R0;
+    o.col(a) = -W.col(0) * gbar[a];
   }
   std::vector<int> nodes;
   for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(0, k));
   auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, C, o, k_over_m);
-  problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks());
+  ids.push_back(problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks()));
+  return ids;
 }
 
 }  // namespace
@@ -228,6 +379,12 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   }
   if (!(options.initial_trust_region_radius > 0)) {
     throw UsageError(fmt::format("the initial trust-region radius must be > 0, got {}", options.initial_trust_region_radius));
+  }
+  if (options.thrust_prior_rounds < 1) {
+    throw UsageError(fmt::format("the thrust prior needs >= 1 empirical-Bayes round, got {}", options.thrust_prior_rounds));
+  }
+  if (options.thrust_prior_order < 2 || options.thrust_prior_order > 3) {
+    throw UsageError(fmt::format("the thrust prior's order must be 2 or 3, got {}", options.thrust_prior_order));
   }
   if (pixels.empty()) throw ComputeError("no camera measurements");
   double t0 = pixels.front().t, t1 = pixels.front().t;
@@ -314,6 +471,9 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   solver.num_threads = options.threads;
   solver.logging_type = ceres::SILENT;
   solver.initial_trust_region_radius = options.initial_trust_region_radius;
+  solver.function_tolerance = options.function_tolerance;
+  solver.gradient_tolerance = options.gradient_tolerance;
+  solver.parameter_tolerance = options.parameter_tolerance;
   const bool adaptive = options.adaptive_rotor_prior && options.sigma_rotor_rate > 0 && options.rotor_prior_order == 1;
   if (adaptive) solver.max_num_iterations = options.pilot_iterations;
   ceres::Solver::Summary summary = problem.Solve(solver);
@@ -329,10 +489,22 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
       const double sigma_s = std::max(options.adaptive_rotor_prior_floor, segment_sigma[s]);
       problem.SetControlSmoothnessSigmas(1, s, Eigen::Vector4d(thrust ? off : sigma_s, sigma_s, sigma_s, sigma_s));
     }
-    if (thrust) AddThrustAccelerationPrior(problem, vehicle, options);
+    std::vector<ceres::ResidualBlockId> thrust_blocks;
+    if (thrust) {
+      thrust_blocks = options.motion_prior ? AddMotionPrior(problem, options)
+                                           : AddThrustAccelerationPrior(problem, vehicle, options);
+    }
     solver.max_num_iterations = options.max_iterations;
     summary = problem.Solve(solver);
     iterations += static_cast<int>(summary.iterations.size()) - 1;
+    for (int round = 1; thrust && round < options.thrust_prior_rounds; ++round) {
+      // Another empirical-Bayes round: λ_a and σ_s from the solution with the thrust prior.
+      for (ceres::ResidualBlockId id : thrust_blocks) problem.ceres_problem().RemoveResidualBlock(id);
+      thrust_blocks = options.motion_prior ? AddMotionPrior(problem, options)
+                                           : AddThrustAccelerationPrior(problem, vehicle, options);
+      summary = problem.Solve(solver);
+      iterations += static_cast<int>(summary.iterations.size()) - 1;
+    }
   }
 
   QuadrotorEstimate out;

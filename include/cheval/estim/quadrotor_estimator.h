@@ -62,6 +62,18 @@ struct QuadrotorEstimateOptions {
   /// (roll, pitch, yaw) components keep the random-walk prior with the per-segment σ above.
   bool thrust_prior = true;
   double thrust_prior_max_rate = 6.0;  ///< rad/s (> 0): the bound of λ_a on an axis without motion
+  /// Empirical-Bayes rounds of the thrust prior (>= 1): after each solve with it, λ_a and σ_s are
+  /// re-estimated from that solution and the problem is solved again (1: from the pilot only).
+  /// These three options are measured variants, not the defaults (docs/estimator.md, "Closing the
+  /// last two aggressive seeds": none gets the aggressive flight under 0.5 % on every seed).
+  int thrust_prior_rounds = 1;
+  /// Order m of the thrust prior (2 or 3; motion_prior too): ∫ |(D + λ_a)^m a_a|² dt, 2 a
+  /// Matérn-3/2 process, 3 a Matérn-5/2 one (λ_a = √3 × the rms frequency, f'' continuous as well, its stationary law of
+  /// (a, a', a'') at the first time).
+  int thrust_prior_order = 2;
+  /// The Matérn-3/2 prior of thrust_prior on the kinematic acceleration v' (a motion prior; the
+  /// collective follows through the collocation of v' = f − g − drag) instead of on f − ḡ.
+  bool motion_prior = false;
   double huber_pixels = 3.0;  ///< Huber threshold on each landmark's whitened pixel error (in σ)
   /// Window of the flatness-based initialisation (FlatnessInitialState), s (> 0).
   double initial_window_s = 0.6;
@@ -70,6 +82,9 @@ struct QuadrotorEstimateOptions {
   /// 3–4 iterations instead of 6–7, the same minimum (docs/estimator.md).
   double initial_trust_region_radius = 1e8;
   int max_iterations = 50;
+  /// Ceres' convergence tolerances (its defaults): relative cost change, gradient, step. Tighter
+  /// ones change nothing (the solve is converged: docs/estimator.md).
+  double function_tolerance = 1e-6, gradient_tolerance = 1e-10, parameter_tolerance = 1e-8;
   int threads = 1;
   /// Told "solver iterations" with the iterations done so far (total unknown: 0), after each one.
   ProgressFn progress;
