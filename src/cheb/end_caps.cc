@@ -86,9 +86,9 @@ class OneSidedFits {
  private:
   // Above this many sample-degree products the library's vectorised accumulation is faster.
   static constexpr Eigen::Index kMomentLoopLimit = 2048;
-  // The normal equations from Chebyshev moments, G_ij = (S_{i+j} + S_{|i-j|}) / 2 with S_n = Σ
-  // T_n(x_i) (fit.h), accumulated directly: for these short fits this beats BuildNormalEquations,
-  // whose vectorised accumulation is made for long windows.
+  // The normal equations from Chebyshev moments, G_ij = (S_{i+j} + S_{|i-j|}) / 2 with
+  // S_n = Σ T_n(x_i) (fit.h), accumulated directly: for these short fits this beats
+  // BuildNormalEquations, whose vectorised accumulation is made for long windows.
   static NormalEquations SmallNormalEquations(const Block& block, Eigen::Index m, int top) {
     NormalEquations normal;
     normal.interval = {0.0, block.tau[m - 1]};
@@ -119,8 +119,8 @@ class OneSidedFits {
   Eigen::MatrixXd derivative_basis_;  // count x (top + 1)
 };
 
-// Weight of the cap at offset j (samples from the end) for boundary z: the curve's blend, 1 − s((j
-// − z/2)/z) with s the quintic smoothstep (Curve::Locate with half-width z/2).
+// Weight of the cap at offset j (samples from the end) for boundary z: the curve's blend,
+// 1 − s((j − z/2)/z) with s the quintic smoothstep (Curve::Locate with half-width z/2).
 double CapWeight(Eigen::Index j, int z) {
   double s = 0, ds = 0, dds = 0;
   Smoothstep((static_cast<double>(j) - 0.5 * z) / z, &s, &ds, &dds);
@@ -128,16 +128,17 @@ double CapWeight(Eigen::Index j, int z) {
 }
 Eigen::Index BlendEnd(int z) { return static_cast<Eigen::Index>(std::ceil(1.5 * z)) + 1; }
 
+// A cap candidate and its pooled statistics over the artificial ends, per offset and coordinate:
+// a = Σ Δ², b = Σ Δ·e with Δ = v_cap − v_end and e = v_end − v_reference. The blended velocity
+// v_end + wΔ has the error e + wΔ, so the cap changes the summed squared error by Σ w²a + 2w·b.
 struct Candidate {
   int samples = 0, degree = 0;
   Eigen::Index offsets = 0;  // velocities compared at offsets 0..offsets-1
-  Eigen::MatrixXd a, b;      // pooled Σ Δ² and Σ Δ·e per offset and coordinate (Δ =
-                             // cap − end, e = end − reference)
+  Eigen::MatrixXd a, b;
 };
 
 struct Choice {
-  double gain = 0;  // pooled change of the summed squared velocity error (< 0:
-                    // the cap helps)
+  double gain = 0;  // pooled change of the summed squared velocity error (< 0: the cap helps)
   int samples = 0, boundary = 0;
   std::vector<int> degrees;  // per coordinate; -1 keeps the end window's polynomial
 };
