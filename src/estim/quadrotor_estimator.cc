@@ -171,6 +171,69 @@ class VelocityRowsCost : public ceres::CostFunction {
   std::vector<double*> blocks_;
 };
 
+// The parts a Matérn prior of order m (2: Matérn-3/2, 3: Matérn-5/2) takes from the pilot, per world
+// axis a, for a quantity x(t) known at the nodes of each segment (X_s, N + 1 x 3) through the
+// Gauss–Legendre rows q_s[j] of its j-th derivative (j = 0..m; |q_s[j] X_s|² = ∫_s |x^(j)|² dt):
+// λ_a matched to the root-mean-square frequency ν = sqrt(−∫x''x / ∫x²) of the pilot's x_a (a
+// Matérn-3/2 process has ν = λ, a Matérn-5/2 one ν = λ/√3; at most max_rate), the rows of
+// (D + λ_a)^m over each segment, and σ_s, the maximum-likelihood intensity of segment s (3 axes of
+// N + 1 − m increments).
+struct MaternParts {
+  Eigen::Vector3d lambda;
+  std::vector<std::array<Eigen::MatrixXd, 3>> rows;  // per segment and axis
+  std::vector<double> sigma;                         // per segment
+};
+
+MaternParts FitMaternParts(const std::vector<std::array<Eigen::MatrixXd, 4>>& q, const std::vector<Eigen::MatrixXd>& X,
+                           int m, int N, double max_rate) {
+  const int S = static_cast<int>(X.size());
+  Eigen::Vector3d num = Eigen::Vector3d::Zero(), den = Eigen::Vector3d::Zero();
+  for (int s = 0; s < S; ++s) {
+    const Eigen::MatrixXd A0 = q[s][0] * X[s], A2 = q[s][2] * X[s];
+    for (int a = 0; a < 3; ++a) {
+      num[a] -= A2.col(a).dot(A0.col(a));  // ∫ x'' x = −∫ |x'|² + ends
+      den[a] += A0.col(a).squaredNorm();
+    }
+  }
+  MaternParts parts;
+  const double rms_to_lambda = m == 3 ? std::sqrt(3.0) : 1.0;
+  for (int a = 0; a < 3; ++a) {
+    parts.lambda[a] =
+        rms_to_lambda * std::sqrt(std::clamp(den[a] > 0 ? num[a] / den[a] : 0.0, 0.0, max_rate * max_rate));
+  }
+  const double binomial[4][4] = {{1, 0, 0, 0}, {1, 1, 0, 0}, {1, 2, 1, 0}, {1, 3, 3, 1}};
+  parts.rows.resize(S);
+  parts.sigma.resize(S);
+  for (int s = 0; s < S; ++s) {
+    double e = 0;
+    for (int a = 0; a < 3; ++a) {
+      parts.rows[s][a] = Eigen::MatrixXd::Zero(N + 1, N + 1);
+      for (int j = 0; j <= m; ++j) parts.rows[s][a] += binomial[m][j] * std::pow(parts.lambda[a], m - j) * q[s][j];
+      e += (parts.rows[s][a] * X[s].col(a)).squaredNorm();
+    }
+    parts.sigma[s] = std::max(std::sqrt(e / (3.0 * (N + 1 - m))), 1e-9);
+  }
+  return parts;
+}
+
+// W with |W y|² = yᵀ P⁻¹ y for the stationary covariance P of the process's first state
+// y = (x, x', .., x^(m−1)): with the energy of (D + λ)^m x, the exact density of the stationary
+// process. From the spectrum σ² / (λ² + ω²)^m: m = 2: P = diag(1/(4λ³), 1/(4λ)) σ²; m = 3:
+// P = [[3, 0, −λ²], [0, λ², 0], [−λ², 0, 3λ⁴]] σ² / (16λ⁵).
+Eigen::MatrixXd StationaryStartWhitening(int m, double lambda, double sigma) {
+  const double l = lambda;
+  Eigen::MatrixXd cov(m, m);
+  if (m == 2) {
+    cov << 1 / (4 * l * l * l), 0, 0, 1 / (4 * l);
+  } else {
+    cov << 3, 0, -l * l, 0, l * l, 0, -l * l, 0, 3 * l * l * l * l;
+    cov /= 16 * std::pow(l, 5);
+  }
+  cov *= sigma * sigma;
+  const Eigen::MatrixXd info = cov.inverse();
+  return Eigen::LLT<Eigen::MatrixXd>(info).matrixL().transpose();
+}
+
 // The kinematic acceleration's prior (QuadrotorEstimateOptions::motion_prior): per world axis a, a
 // Matérn-3/2 process on v_a', ∫ |(D + λ_a)² v_a'|² dt / σ_s² per segment, λ_a and σ_s from the
 // pilot as in AddThrustAccelerationPrior, v' and v'' continuous at the breakpoints and the
@@ -179,40 +242,19 @@ class VelocityRowsCost : public ceres::CostFunction {
 std::vector<ceres::ResidualBlockId> AddMotionPrior(Problem& problem, const QuadrotorEstimateOptions& options) {
   std::vector<ceres::ResidualBlockId> ids;
   const int S = problem.num_segments(), N = options.degree;
-  std::vector<Eigen::MatrixXd> V(S);
   const int m = options.thrust_prior_order;  // 2: Matérn-3/2 on v', 3: Matérn-5/2
-  std::vector<std::array<Eigen::MatrixXd, 5>> Q(S);  // GL rows of the 1st .. 4th derivatives of v
-  Eigen::Vector3d num = Eigen::Vector3d::Zero(), den = Eigen::Vector3d::Zero();
+  std::vector<Eigen::MatrixXd> V(S);
+  std::vector<std::array<Eigen::MatrixXd, 4>> Q(S);  // GL rows of v', v'', ... (the velocity's 1st .. (m+1)-th derivatives)
   for (int s = 0; s < S; ++s) {
     V[s].resize(N + 1, 3);
     for (int k = 0; k <= N; ++k) {
       V[s].row(k) = Eigen::Map<const Eigen::Vector3d>(problem.Vector(problem.NodeOf(s, k)) + 3).transpose();
     }
-    for (int j = 1; j <= m + 1; ++j) Q[s][j] = problem.SmoothnessMatrix(j, s, N + 1);
-    const Eigen::MatrixXd A0 = Q[s][1] * V[s], A2 = Q[s][3] * V[s];
-    for (int a = 0; a < 3; ++a) {
-      num[a] -= A2.col(a).dot(A0.col(a));
-      den[a] += A0.col(a).squaredNorm();
-    }
+    for (int j = 0; j <= m; ++j) Q[s][j] = problem.SmoothnessMatrix(j + 1, s, N + 1);
   }
-  Eigen::Vector3d lambda;
-  const double rms_to_lambda = m == 3 ? std::sqrt(3.0) : 1.0;
-  for (int a = 0; a < 3; ++a) {
-    lambda[a] = rms_to_lambda * std::sqrt(std::clamp(den[a] > 0 ? num[a] / den[a] : 0.0, 0.0,
-                                     options.thrust_prior_max_rate * options.thrust_prior_max_rate));
-  }
-  std::vector<std::array<Eigen::MatrixXd, 3>> rows(S);
-  std::vector<double> sigma_f(S);
-  for (int s = 0; s < S; ++s) {
-    double e = 0;
-    for (int a = 0; a < 3; ++a) {
-      const double l = lambda[a];
-      rows[s][a] = m == 2 ? Eigen::MatrixXd(Q[s][3] + 2 * l * Q[s][2] + l * l * Q[s][1])
-                          : Eigen::MatrixXd(Q[s][4] + 3 * l * Q[s][3] + 3 * l * l * Q[s][2] + l * l * l * Q[s][1]);
-      e += (rows[s][a] * V[s].col(a)).squaredNorm();
-    }
-    sigma_f[s] = std::max(std::sqrt(e / (3.0 * (N + 1 - m))), 1e-9);
-  }
+  const MaternParts parts = FitMaternParts(Q, V, m, N, options.thrust_prior_max_rate);
+  const std::vector<std::array<Eigen::MatrixXd, 3>>& rows = parts.rows;
+  const std::vector<double>& sigma_f = parts.sigma;
   for (int s = 0; s < S; ++s) {
     std::vector<int> nodes;
     for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(s, k));
@@ -235,19 +277,7 @@ std::vector<ceres::ResidualBlockId> AddMotionPrior(Problem& problem, const Quadr
   R0.row(0) = row.dw;
   for (int i = 1; i < m; ++i) R0.row(i) = scale * R0.row(i - 1) * D;
   std::array<Eigen::MatrixXd, 3> C;
-  for (int a = 0; a < 3; ++a) {
-    const double l = lambda[a];
-    Eigen::MatrixXd cov(m, m);
-    if (m == 2) {
-      cov << 1 / (4 * l * l * l), 0, 0, 1 / (4 * l);
-    } else {
-      cov << 3, 0, -l * l, 0, l * l, 0, -l * l, 0, 3 * l * l * l * l;
-      cov /= 16 * std::pow(l, 5);
-    }
-    cov *= sigma_f[0] * sigma_f[0];
-    const Eigen::MatrixXd info = cov.inverse();
-    C[a] = Eigen::LLT<Eigen::MatrixXd>(info).matrixL().transpose() * R0;
-  }
+  for (int a = 0; a < 3; ++a) C[a] = StationaryStartWhitening(m, parts.lambda[a], sigma_f[0]) * R0;
   std::vector<int> nodes;
   for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(0, k));
   auto* cost = new VelocityRowsCost(problem, nodes, C);
@@ -269,7 +299,6 @@ std::vector<ceres::ResidualBlockId> AddThrustAccelerationPrior(Problem& problem,
   const int m = options.thrust_prior_order;  // 2: Matérn-3/2, (D + λ)² a; 3: Matérn-5/2, (D + λ)³ a
   std::vector<Eigen::MatrixXd> F(S);  // pilot's f − ḡ at the nodes
   std::vector<std::array<Eigen::MatrixXd, 4>> Q(S);  // GL rows of 1, D, D², D³
-  Eigen::Vector3d num = Eigen::Vector3d::Zero(), den = Eigen::Vector3d::Zero();
   for (int s = 0; s < S; ++s) {
     F[s].resize(N + 1, 3);
     for (int k = 0; k <= N; ++k) {
@@ -278,35 +307,14 @@ std::vector<ceres::ResidualBlockId> AddThrustAccelerationPrior(Problem& problem,
                      gbar).transpose();
     }
     for (int j = 0; j <= m; ++j) Q[s][j] = problem.SmoothnessMatrix(j, s, N + 1);
-    const Eigen::MatrixXd A0 = Q[s][0] * F[s], A2 = Q[s][2] * F[s];
-    for (int a = 0; a < 3; ++a) {
-      num[a] -= A2.col(a).dot(A0.col(a));  // ∫ a'' a = −∫ |a'|² + ends
-      den[a] += A0.col(a).squaredNorm();
-    }
   }
-  // λ_a: matched to the root-mean-square frequency ν of the pilot's acceleration on axis a,
-  // ν = sqrt(−∫a''a / ∫a²): a Matérn-3/2 process has ν = λ, a Matérn-5/2 one ν = λ/√3.
-  Eigen::Vector3d lambda;
-  const double rms_to_lambda = m == 3 ? std::sqrt(3.0) : 1.0;
-  for (int a = 0; a < 3; ++a) {
-    lambda[a] = rms_to_lambda * std::sqrt(std::clamp(den[a] > 0 ? num[a] / den[a] : 0.0, 0.0,
-                                                     options.thrust_prior_max_rate * options.thrust_prior_max_rate));
-  }
-  std::vector<std::array<Eigen::MatrixXd, 3>> rows(S);
-  std::vector<Eigen::MatrixXd> offsets(S);
-  std::vector<double> sigma_f(S);
-  const double binomial[4][4] = {{1, 0, 0, 0}, {1, 1, 0, 0}, {1, 2, 1, 0}, {1, 3, 3, 1}};
+  const MaternParts parts = FitMaternParts(Q, F, m, N, options.thrust_prior_max_rate);
+  const std::vector<std::array<Eigen::MatrixXd, 3>>& rows = parts.rows;
+  const std::vector<double>& sigma_f = parts.sigma;
+  // The rows act on f; the prior is on f − ḡ: offsets −λ^m ḡ_a (the constant's only surviving term).
+  std::vector<Eigen::MatrixXd> offsets(S, Eigen::MatrixXd(N + 1, 3));
   for (int s = 0; s < S; ++s) {
-    offsets[s].resize(N + 1, 3);
-    double e = 0;
-    for (int a = 0; a < 3; ++a) {
-      rows[s][a] = Eigen::MatrixXd::Zero(N + 1, N + 1);
-      for (int j = 0; j <= m; ++j) rows[s][a] += binomial[m][j] * std::pow(lambda[a], m - j) * Q[s][j];
-      offsets[s].col(a) = -std::pow(lambda[a], m) * gbar[a] * Q[s][0].rowwise().sum();
-      e += (rows[s][a] * F[s].col(a)).squaredNorm();
-    }
-    // Maximum-likelihood intensity of the segment: 3 axes of N + 1 − m increments.
-    sigma_f[s] = std::max(std::sqrt(e / (3.0 * (N + 1 - m))), 1e-9);
+    for (int a = 0; a < 3; ++a) offsets[s].col(a) = -std::pow(parts.lambda[a], m) * gbar[a] * Q[s][0].rowwise().sum();
   }
   for (int s = 0; s < S; ++s) {
     std::vector<int> nodes;
@@ -323,10 +331,8 @@ std::vector<ceres::ResidualBlockId> AddThrustAccelerationPrior(Problem& problem,
     cost->set_weight(1.0 / std::sqrt(sigma_f[s] * sigma_f[s + 1]));
     ids.push_back(problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks()));
   }
-  // The stationary process's first state (a, a', .., a^(m−1)) at t0: with the energy of (D + λ)^m a
-  // above, the exact density of the stationary process. Its covariance per axis, from the spectrum
-  // σ² / (λ² + ω²)^m: m = 2: diag(1/(4λ³), 1/(4λ)) σ²; m = 3: [[3, 0, −λ²], [0, λ², 0],
-  // [−λ², 0, 3λ⁴]] σ² / (16λ⁵).
+  // The stationary law of the process's first state (a, a', .., a^(m−1)) at t0
+  // (StationaryStartWhitening).
   const detail::TimeRow row = problem.RowAt(problem.start_time());
   Eigen::MatrixXd R0(m, N + 1);  // rows of a, a', a'' at t0 in the first segment's point order
   R0.row(0) = row.w;
@@ -339,17 +345,7 @@ std::vector<ceres::ResidualBlockId> AddThrustAccelerationPrior(Problem& problem,
   std::array<Eigen::MatrixXd, 3> C;
   Eigen::MatrixXd o(m, 3);
   for (int a = 0; a < 3; ++a) {
-    const double l = lambda[a];
-    Eigen::MatrixXd cov(m, m);
-    if (m == 2) {
-      cov << 1 / (4 * l * l * l), 0, 0, 1 / (4 * l);
-    } else {
-      cov << 3, 0, -l * l, 0, l * l, 0, -l * l, 0, 3 * l * l * l * l;
-      cov /= 16 * std::pow(l, 5);
-    }
-    cov *= sigma_f[0] * sigma_f[0];
-    const Eigen::MatrixXd info = cov.inverse();
-    const Eigen::MatrixXd W = Eigen::LLT<Eigen::MatrixXd>(info).matrixL().transpose();  // |W x|² = xᵀ info x
+    const Eigen::MatrixXd W = StationaryStartWhitening(m, parts.lambda[a], sigma_f[0]);
     C[a] = W * R0;
     o.col(a) = -W.col(0) * gbar[a];
   }

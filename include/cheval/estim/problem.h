@@ -304,28 +304,12 @@ class PseudoSpectralProblem {
     }
     if (first_order_ == 0) first_order_ = order;
     // Continuity of u', ..., u^(m-1) at the inner breakpoints.
-    const double h_unit = 1.0 - basis_.points()[1];  // shortest node spacing in x (at the ends)
-    for (int s = 0; s + 1 < num_segments(); ++s) {
-      const double scale_a = Interval(s).DerivativeScale(), scale_b = Interval(s + 1).DerivativeScale();
-      const double h = std::min(h_unit / scale_a, h_unit / scale_b);
+    for (int s = 0; order > 1 && s + 1 < num_segments(); ++s) {
       std::vector<int> nodes;
       for (int g = s * N; g <= (s + 2) * N; ++g) nodes.push_back(g);
-      Eigen::MatrixXd coefficients = Eigen::MatrixXd::Zero(order - 1, 2 * N + 1);
-      Eigen::MatrixXd Di = Eigen::MatrixXd::Identity(N + 1, N + 1);
-      for (int i = 1; i < order; ++i) {
-        Di = D_ * Di;
-        const double sigma_i = sigma * std::pow(h, order - i - 0.5);
-        // Segment s ends at its point k = 0 (global node (s + 1) N); segment s + 1 starts at its point k = N.
-        for (int k = 0; k <= N; ++k) {
-          coefficients(i - 1, NodeOf(s, k) - s * N) += std::pow(scale_a, i) * Di(0, k) / sigma_i;
-          coefficients(i - 1, NodeOf(s + 1, k) - s * N) -= std::pow(scale_b, i) * Di(N, k) / sigma_i;
-        }
-      }
-      if (order > 1) {
-        auto* cost = new LinearControlCost(this, nodes, coefficients, basis);
-        problem_->AddResidualBlock(cost, nullptr, cost->blocks());
-        prior.jumps.push_back(cost);
-      }
+      auto* cost = new LinearControlCost(this, nodes, SmoothnessJumpMatrix(order, s, sigma), basis);
+      problem_->AddResidualBlock(cost, nullptr, cost->blocks());
+      prior.jumps.push_back(cost);
     }
   }
 
@@ -388,6 +372,7 @@ class PseudoSpectralProblem {
     for (int i = 1; i < order; ++i) {
       Di = D_ * Di;
       const double sigma_i = sigma * std::pow(h, order - i - 0.5);
+      // Segment s ends at its point k = 0 (global node (s + 1) N); segment s + 1 starts at its point k = N.
       for (int k = 0; k <= N; ++k) {
         coefficients(i - 1, NodeOf(s, k) - s * N) += std::pow(scale_a, i) * Di(0, k) / sigma_i;
         coefficients(i - 1, NodeOf(s + 1, k) - s * N) -= std::pow(scale_b, i) * Di(N, k) / sigma_i;
