@@ -278,11 +278,12 @@ def simulate_quadrotor(scenario, output, *, seed=1, duration=10.0, vehicle=DEFAU
     _cheval.simulate_quadrotor(scenario, _os.fspath(output), seed, float(duration), _os.fspath(vehicle))
 
 
-def estimate_quadrotor(*, scenario=None, data=None, seed=1, duration=10.0, vehicle=None, degree=10, segment=1.0):
+def estimate_quadrotor(*, scenario=None, data=None, seed=1, duration=10.0, vehicle=None, degree=None, segment=None):
     """States and rotor speeds of a quadrotor from camera measurements and its dynamics, as ``cheval
     estimate quadrotor`` (docs/estimator.md). Give a data folder (``data=``, as written by
     simulate_quadrotor; its vehicle.json unless ``vehicle`` is given) or a scenario to simulate
     (``scenario=``, with ``seed``, ``duration`` and ``vehicle``, default DEFAULT_VEHICLE).
+    ``degree`` and ``segment`` (s) override the CLI's defaults (degree 4, 0.2 s segments).
 
     Returns the dict of ``cheval estimate quadrotor --json`` (states, segments, degree, iterations,
     seconds, converged and, with a ground truth, rotor_error_rpm, rotor_error_percent,
@@ -295,7 +296,8 @@ def estimate_quadrotor(*, scenario=None, data=None, seed=1, duration=10.0, vehic
         vehicle = DEFAULT_VEHICLE
     text, arrays = _cheval.estimate_quadrotor(scenario, None if data is None else _os.fspath(data), seed,
                                               float(duration), None if vehicle is None else _os.fspath(vehicle),
-                                              int(degree), float(segment))
+                                              None if degree is None else int(degree),
+                                              None if segment is None else float(segment))
     result = _json.loads(text)
     result["estimate"] = arrays
     return result

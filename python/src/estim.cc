@@ -38,13 +38,13 @@ void SimulateQuadrotor(const std::string& scenario, const std::string& output, u
 
 // (the JSON text of `cheval estimate quadrotor --json`, the states as arrays)
 py::tuple EstimateQuadrotor(const std::optional<std::string>& scenario, const std::optional<std::string>& data_folder,
-                            uint64_t seed, double duration, const std::optional<std::string>& vehicle, int degree,
-                            double segment) {
+                            uint64_t seed, double duration, const std::optional<std::string>& vehicle,
+                            std::optional<int> degree, std::optional<double> segment) {
   if (scenario.has_value() == data_folder.has_value()) throw UsageError("give exactly one of scenario= or data=");
   if (scenario && !vehicle) throw UsageError("a simulated scenario needs vehicle= (e.g. cheval.DEFAULT_VEHICLE)");
   estim::QuadrotorEstimateOptions options;
-  options.degree = degree;
-  options.segment_s = segment;
+  if (degree) options.degree = *degree;  // else the library's defaults
+  if (segment) options.segment_s = *segment;
   std::string json;
   std::vector<sim::QuadrotorTruth> states;
   {

@@ -47,7 +47,8 @@ class EstimatorTest(unittest.TestCase):
     def test_scenario_with_the_default_vehicle(self):
         self.assertTrue(os.path.isfile(cheval.DEFAULT_VEHICLE))
         r = cheval.estimate_quadrotor(scenario="hover", seed=2, duration=2)
-        self.assertEqual(r["segments"], 2)
+        self.assertEqual(r["segments"], 10)  # the defaults: 0.2 s segments
+        self.assertEqual(r["degree"], 4)
         self.assertTrue(all(p < 1.5 for p in r["rotor_error_percent"]), r["rotor_error_percent"])
 
     def test_errors_carry_the_cli_messages(self):

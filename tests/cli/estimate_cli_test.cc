@@ -50,9 +50,9 @@ TEST_F(CliTest, SimulateThenEstimateFromTheFolder) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   ASSERT_EQ(j["rotor_error_percent"].size(), 4u);
-  EXPECT_EQ(j["degree"].get<int>(), 10);
-  EXPECT_EQ(j["segments"].get<int>(), 3);
-  EXPECT_EQ(j["states"].get<int>(), 31);
+  EXPECT_EQ(j["degree"].get<int>(), 4);  // the defaults: degree 4, 0.2 s segments over the 3 s flight
+  EXPECT_EQ(j["segments"].get<int>(), 15);
+  EXPECT_EQ(j["states"].get<int>(), 61);
   for (const auto& e : j["rotor_error_percent"]) EXPECT_LT(e.get<double>(), 1.5);
   EXPECT_LT(j["position_rmse_m"].get<double>(), 0.02);
 

@@ -23,5 +23,5 @@ except cheval.ComputeError as e:
     assert "at least 3 associated pairs, got 2" in str(e), e
 assert os.path.realpath(cheval.DEFAULT_VEHICLE).startswith(where), cheval.DEFAULT_VEHICLE  # inside the package
 r = cheval.estimate_quadrotor(scenario="hover", duration=1)
-assert r["segments"] == 1 and len(r["estimate"]["times"]) == 101, r
+assert r["segments"] == 5 and len(r["estimate"]["times"]) == 101, r  # 0.2 s segments by default
 print(f"cheval imported from {where}; {len(t)} poses")

@@ -33,8 +33,12 @@ struct PoseSample {
 
 /// Defaults chosen once for every scenario (docs/estimator.md explains them).
 struct QuadrotorEstimateOptions {
-  int degree = 10;          ///< --degree: polynomial degree per segment (>= 2)
-  double segment_s = 1.0;   ///< --segment: segment length, s (> 0); the flight is cut into round(T / segment_s) segments
+  /// --degree: polynomial degree per segment (>= 2). --segment: segment length, s (> 0); the flight
+  /// is cut into round(T / segment_s) segments. Short, low-degree segments because the priors' σ are
+  /// estimated per segment: 0.2 s resolves where the thrust changes fast (docs/estimator.md,
+  /// "Segments").
+  int degree = 4;
+  double segment_s = 0.2;
   /// σ of the collocation defects: p' (m/s), v' (m/s²), ω' (rad/s²), body rate of R (rad/s).
   double sigma_position_rate = 1e-3, sigma_acceleration = 1e-2, sigma_angular_acceleration = 1e-1,
          sigma_rotation_rate = 1e-3;
@@ -128,8 +132,8 @@ QuadrotorStateEstimate FlatnessInitialState(const QuadrotorParameters& vehicle, 
 /// `energy[s]` = ∫_s |u'|² dt of a pilot estimate (summed over `controls` entries) on segments of
 /// `degree`: with n increments of a random walk of intensity σ², Σ (Δu)²/Δt ≈ ∫ |u'|² has mean σ² n,
 /// so σ̂² = ∫ |u'|² / n with n = controls · degree per segment. Pooled over the segment and its
-/// neighbours (s − 1, s, s + 1 where they exist: 2–3 segments, 20–30 increments per control at
-/// degree 10), since one segment's estimate would be too noisy. Throws UsageError for degree < 1,
+/// neighbours (s − 1, s, s + 1 where they exist: 2–3 segments, 8–12 increments per control at the
+/// default degree 4), since one segment's estimate would be too noisy. Throws UsageError for degree < 1,
 /// controls < 1 or a negative energy.
 std::vector<double> AdaptiveRotorPriorSigma(const std::vector<double>& energy, int degree, int controls);
 
