@@ -154,7 +154,7 @@ Flight FourSecondFlight(const estim::Vehicle& v, sim::QuadrotorScenario scenario
 }
 
 // End to end on a short hover and a short figure-eight with the defaults: the rotor speeds come back
-// to well within 1 % (the 10 s runs of docs/estimator.md measure 0.03-0.56 %; 4 s flights have
+// to well within 1 % (the 10 s runs of docs/estimator.md measure at most 0.47 %; 4 s flights have
 // relatively more interval ends, so the bound here is 1 %), poses to a centimetre.
 TEST(QuadrotorEstimator, RecoversRotorSpeedsFromTheCamera) {
   const estim::Vehicle v = estim::ReadVehicle(kVehicle);
@@ -260,11 +260,12 @@ TEST(QuadrotorEstimator, AdaptiveRotorPriorSigmaIsTheRandomWalkMaximumLikelihood
 // End to end: the adaptive prior (the default) against one σ_u = 100 everywhere on a 4 s hover and
 // a 4 s aggressive flight (seed 1). Hover: the truth's rotor speeds are constant, so the pilot's
 // rotor rate is noise and σ drops to the floor; the collective's thrust-acceleration prior
-// (thrust_prior, the default) gives 0.071 % against 0.429 % (bound: half); aggressive: 0.352 %
-// against 0.950 % (bound: better), and 0.835 % with the collective's random-walk prior instead
-// (thrust_prior = false; bound: better). Iterations: 3 in all (one pilot iteration plus two of the
-// final solve, as the fixed σ_u's 3) except the short aggressive flight with the thrust prior, 8
-// (bound: three times; the 10 s flights of docs/estimator.md take 3).
+// (thrust_prior, the default) gives 0.066 % against 0.434 % (bound: half); aggressive: 0.512 %
+// against 0.939 % (bound: better), and 0.945 % with the collective's random-walk prior instead
+// (thrust_prior = false; bound: better). (Figures of the defaults, degree 4 on 0.2 s.) Iterations:
+// 3 in all (one pilot iteration plus two of the final solve, as the fixed σ_u's 3) except the short
+// aggressive flight with the thrust prior, 4 (bound: three times; the 10 s flights of
+// docs/estimator.md take 3).
 TEST(QuadrotorEstimator, AdaptiveRotorPriorBeatsOneFixedSigma) {
   const estim::Vehicle v = estim::ReadVehicle(kVehicle);
   for (sim::QuadrotorScenario scenario : {sim::QuadrotorScenario::kHover, sim::QuadrotorScenario::kAggressive}) {
@@ -306,7 +307,7 @@ TEST(QuadrotorEstimator, AdaptiveRotorPriorBeatsOneFixedSigma) {
 // not make the default: a second empirical-Bayes round (thrust_prior_rounds = 2), a Matérn-5/2
 // process (thrust_prior_order = 3) and the Matérn-3/2 prior on the kinematic acceleration v'
 // (motion_prior). On the 4 s aggressive flight (seed 1) all converge to within 0.1 percentage points
-// of the default's error (0.364 / 0.380 / 0.347 % against 0.352 %); bad values are UsageErrors.
+// of the default's error (0.557 / 0.460 / 0.474 % against 0.512 %); bad values are UsageErrors.
 TEST(QuadrotorEstimator, ThrustPriorVariantsRunAndValidate) {
   const estim::Vehicle v = estim::ReadVehicle(kVehicle);
   const Flight flight = FourSecondFlight(v, sim::QuadrotorScenario::kAggressive);
