@@ -6,19 +6,9 @@
 // tests/data/fuzz/curve/.
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
-#include <optional>
-#include <string>
-#include <string_view>
 
 #include "fuzz_checks.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  const std::optional<std::string> violation =
-      cheval::fuzz::CheckCurveInput(std::string_view(reinterpret_cast<const char*>(data), size));
-  if (violation) {
-    std::fprintf(stderr, "property violated: %s\n", violation->c_str());
-    __builtin_trap();
-  }
-  return 0;
+  return cheval::fuzz::TrapOnViolation(cheval::fuzz::CheckCurveInput(cheval::fuzz::AsText(data, size)));
 }

@@ -493,4 +493,12 @@ std::optional<std::string> CheckCurveInput(std::string_view data) {
   return std::nullopt;
 }
 
+int TrapOnViolation(const std::optional<std::string>& violation) {
+  if (violation) {
+    std::fprintf(stderr, "property violated: %s\n", violation->c_str());
+    __builtin_trap();
+  }
+  return 0;
+}
+
 }  // namespace cheval::fuzz

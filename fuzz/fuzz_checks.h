@@ -1,12 +1,14 @@
 #pragma once
 /// \file
 /// What the libFuzzer targets of fuzz/ run on one input and the properties they check, in one place.
-/// The targets (trajectory_fuzzer.cc, stamp_fuzzer.cc) trap on a violation; the regression test
+/// The targets (*_fuzzer.cc) trap on a violation (TrapOnViolation); the regression test
 /// (tests/traj/fuzz_regression_test.cc) replays tests/data/fuzz/<target>/ through the same functions,
 /// so a kept input is checked exactly as the fuzzer checked it. Needs the cheval library only: no
 /// libFuzzer, no GoogleTest. The properties are listed in docs/fuzzing.md.
 
 #include <array>
+#include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -65,5 +67,14 @@ std::optional<std::string> CheckModelInput(std::string_view data);
 /// that Curve::FromParts accepts, and whose value, velocity and acceleration are finite at every
 /// sample. Returns nullopt or the violated property.
 std::optional<std::string> CheckCurveInput(std::string_view data);
+
+/// libFuzzer's input as the text the checks take.
+inline std::string_view AsText(const uint8_t* data, size_t size) {
+  return {reinterpret_cast<const char*>(data), size};
+}
+
+/// What every target does with a check's result: a violated property is printed and trapped on
+/// (libFuzzer keeps the input as a crash); otherwise libFuzzer's 0.
+int TrapOnViolation(const std::optional<std::string>& violation);
 
 }  // namespace cheval::fuzz

@@ -7,10 +7,6 @@
 // a crash, a sanitizer report, a hang or another exception escaping is reported by libFuzzer itself.
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
-#include <optional>
-#include <string>
-#include <string_view>
 
 #include "fuzz_checks.h"
 
@@ -21,11 +17,6 @@
 #define CHEVAL_FUZZ_STRINGIFY(x) CHEVAL_FUZZ_STRINGIFY2(x)
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  const std::optional<std::string> violation = cheval::fuzz::CheckTrajectoryInput(
-      CHEVAL_FUZZ_STRINGIFY(CHEVAL_FUZZ_FORMAT), std::string_view(reinterpret_cast<const char*>(data), size));
-  if (violation) {
-    std::fprintf(stderr, "property violated: %s\n", violation->c_str());
-    __builtin_trap();
-  }
-  return 0;
+  return cheval::fuzz::TrapOnViolation(cheval::fuzz::CheckTrajectoryInput(CHEVAL_FUZZ_STRINGIFY(CHEVAL_FUZZ_FORMAT),
+                                                                       cheval::fuzz::AsText(data, size)));
 }
