@@ -11,4 +11,10 @@ InputError::InputError(std::string path, int64_t line, int64_t column, const std
       column_(column),
       detail_(what) {}
 
+OptionError::OptionError(std::string options, std::string field, std::string rule)
+    : UsageError(fmt::format("{}::{} {}", options, field, rule)),
+      options_(std::move(options)),
+      field_(std::move(field)),
+      rule_(std::move(rule)) {}
+
 }  // namespace cheval

@@ -349,25 +349,6 @@ TEST(UnicycleModel, RecoversControlsFromPositions) {
   ExpectJacobianMatchesDifferences(problem);
 }
 
-// Gauss–Legendre with n points integrates every monomial of degree <= 2n − 1 exactly on [-1, 1]
-// (∫ x^k = 2/(k+1) for even k, 0 for odd): to rounding, 1e-14 on these O(1) sums.
-TEST(GaussLegendre, IsExactToDegreeTwoNMinusOne) {
-  for (int n = 1; n <= 12; ++n) {
-    Eigen::VectorXd x, w;
-    detail::GaussLegendre(n, &x, &w);
-    for (int k = 0; k <= 2 * n - 1; ++k) {
-      double sum = 0;
-      for (int q = 0; q < n; ++q) sum += w[q] * std::pow(x[q], k);
-      EXPECT_NEAR(sum, k % 2 == 0 ? 2.0 / (k + 1) : 0.0, 1e-14) << "n " << n << " k " << k;
-    }
-    // Degree 2n is not integrated exactly (the rule has exactly 2n − 1 degrees of exactness): the
-    // error there is still 1.8e-7 at n = 12, far above rounding.
-    double sum = 0;
-    for (int q = 0; q < n; ++q) sum += w[q] * std::pow(x[q], 2 * n);
-    EXPECT_GT(std::abs(sum - 2.0 / (2 * n + 1)), 1e-12) << n;
-  }
-}
-
 // A unicycle problem whose controls are the polynomials u0(t) = t³ − 2t, u1(t) = 0.5 t² + 1 on three
 // unequal segments of degree 5 (exactly representable), with only the smoothness prior in it.
 // With `kink`, u0 gets + 3 (t − 1.1) after the second breakpoint: u0' jumps by 3 there.

@@ -51,6 +51,28 @@ class UsageError : public Error {
   using Error::Error;
 };
 
+/// A bad value of one field of an options struct, named by the struct and the field as the library
+/// spells them: what() is `STRUCT::FIELD RULE` ("QuadrotorEstimateOptions::degree must be >= 2, got
+/// 1"). The faces (CLI, Python) translate the field into their own spelling with Message(), so the
+/// library never names a flag or a keyword argument.
+class OptionError : public UsageError {
+ public:
+  /// `options`: the struct ("CurveOptions"); `field`: the member ("degree"); `rule`: what the value
+  /// breaks, starting with a verb ("must be >= 2, got 1").
+  OptionError(std::string options, std::string field, std::string rule);
+
+  const std::string& options() const { return options_; }
+  const std::string& field() const { return field_; }
+  const std::string& rule() const { return rule_; }
+  /// The message with the field spelled as `name` (a flag "--degree", a keyword "degree").
+  std::string Message(const std::string& name) const { return name + " " + rule_; }
+
+ private:
+  std::string options_;
+  std::string field_;
+  std::string rule_;
+};
+
 /// Well-formed input on which the requested computation cannot be done (e.g. too few samples).
 class ComputeError : public Error {
  public:

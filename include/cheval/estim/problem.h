@@ -47,6 +47,7 @@
 #include <Eigen/QR>
 
 #include "cheval/cheb/chebyshev.h"
+#include "cheval/cheb/quadrature.h"
 #include "cheval/common/error.h"
 #include "cheval/estim/manifold.h"
 #include "cheval/lie/so3.h"
@@ -72,36 +73,6 @@ struct TimeRow {
 
 inline Eigen::Matrix3d QuaternionMatrix(const double* q) {
   return Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
-}
-
-/// P_n(z) and P_n'(z) by the three-term recurrence (k P_k = (2k − 1) z P_{k−1} − (k − 1) P_{k−2}).
-inline std::pair<double, double> Legendre(int n, double z) {
-  double previous = 1.0, value = z;
-  for (int k = 2; k <= n; ++k) {
-    const double next = ((2.0 * k - 1.0) * z * value - (k - 1.0) * previous) / k;
-    previous = value;
-    value = next;
-  }
-  if (n == 0) return {1.0, 0.0};
-  return {value, n * (z * value - previous) / (z * z - 1.0)};
-}
-
-/// The n-point Gauss–Legendre rule on [-1, 1] (exact for polynomials of degree 2n − 1): nodes by
-/// Newton's method on P_n from cos(π(i + 3/4)/(n + 1/2)), weights 2 / ((1 − x²) P_n'(x)²).
-inline void GaussLegendre(int n, Eigen::VectorXd* x, Eigen::VectorXd* w) {
-  x->resize(n);
-  w->resize(n);
-  for (int i = 0; i < n; ++i) {
-    double z = std::cos(M_PI * (i + 0.75) / (n + 0.5));
-    for (int it = 0; it < 100; ++it) {
-      const auto [p, dp] = Legendre(n, z);
-      z -= p / dp;
-      if (std::abs(p / dp) < 1e-16) break;
-    }
-    const double dp = Legendre(n, z).second;
-    (*x)[i] = z;
-    (*w)[i] = 2.0 / ((1.0 - z * z) * dp * dp);
-  }
 }
 
 }  // namespace detail
@@ -443,8 +414,9 @@ class PseudoSpectralProblem {
     Eigen::MatrixXd Dm = Eigen::MatrixXd::Identity(N + 1, N + 1);
     for (int i = 0; i < order; ++i) Dm = D_ * Dm;
     const int nq = points > 0 ? points : N - order + 1;
-    Eigen::VectorXd xq, wq;
-    detail::GaussLegendre(nq, &xq, &wq);
+    const cheb::QuadratureRule rule = cheb::GaussLegendre(nq);
+    const Eigen::VectorXd& xq = rule.nodes;
+    const Eigen::VectorXd& wq = rule.weights;
     Eigen::RowVectorXd row(N + 1);
     const double length = breakpoints_[s + 1] - breakpoints_[s];
     const double scale = std::pow(Interval(s).DerivativeScale(), order);
