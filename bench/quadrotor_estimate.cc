@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "cheval/estim/quadrotor_estimator.h"
+#include "cheval/estim/quadrotor_scoring.h"
 #include "cheval/estim/vehicle.h"
 #include "cheval/sim/quadrotor.h"
 
@@ -28,7 +29,7 @@ namespace {
 
 struct Row {
   estim::QuadrotorEstimate estimate;
-  sim::QuadrotorErrors errors;
+  estim::QuadrotorErrors errors;
 };
 
 Row Run(const estim::Vehicle& vehicle, sim::QuadrotorScenario scenario, uint64_t seed, double duration,
@@ -37,12 +38,12 @@ Row Run(const estim::Vehicle& vehicle, sim::QuadrotorScenario scenario, uint64_t
   so.scenario = scenario;
   so.seed = seed;
   so.duration_s = duration;
-  const sim::QuadrotorData data = sim::SimulateQuadrotor(vehicle, so);
+  const estim::QuadrotorData data = sim::SimulateQuadrotor(vehicle, so);
   std::vector<double> times;
   for (const auto& t : data.truth) times.push_back(t.t);
   Row row;
   row.estimate = estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, options, times);
-  row.errors = sim::CompareWithTruth(row.estimate, data.truth);
+  row.errors = estim::CompareWithTruth(row.estimate, data.truth);
   if (!dump.empty()) {  // t, estimated rotor 0..3, true rotor 0..3 (rad/s) at the truth times
     std::FILE* f = std::fopen((dump + "_" + std::string(sim::ToString(scenario)) + "_" + std::to_string(seed) + ".txt").c_str(), "w");
     for (size_t i = 0; i < row.estimate.samples.size() && i < data.truth.size(); ++i) {

@@ -1,5 +1,5 @@
 // The estimator in Python: `cheval sim quadrotor` and `cheval estimate quadrotor` as functions, with
-// the same library calls, the same JSON (sim::QuadrotorEstimateJson) and the estimated states as
+// the same library calls, the same JSON (estim::QuadrotorEstimateJson) and the estimated states as
 // numpy arrays.
 #include <optional>
 #include <string>
@@ -9,7 +9,9 @@
 
 #include "bindings.h"
 #include "cheval/common/error.h"
+#include "cheval/estim/quadrotor_data.h"
 #include "cheval/estim/quadrotor_estimator.h"
+#include "cheval/estim/quadrotor_scoring.h"
 #include "cheval/sim/quadrotor.h"
 
 namespace cheval::python {
@@ -32,8 +34,8 @@ sim::QuadrotorSimOptions SimOptionsOf(const std::string& scenario, uint64_t seed
 void SimulateQuadrotor(const std::string& scenario, const std::string& output, uint64_t seed, double duration,
                        const std::string& vehicle) {
   py::gil_scoped_release release;
-  const sim::QuadrotorData data = sim::SimulateQuadrotor(estim::ReadVehicle(vehicle), SimOptionsOf(scenario, seed, duration));
-  sim::WriteQuadrotorData(data, output);
+  const estim::QuadrotorData data = sim::SimulateQuadrotor(estim::ReadVehicle(vehicle), SimOptionsOf(scenario, seed, duration));
+  estim::WriteQuadrotorData(data, output);
 }
 
 // (the JSON text of `cheval estimate quadrotor --json`, the states as arrays)
@@ -46,28 +48,28 @@ py::tuple EstimateQuadrotor(const std::optional<std::string>& scenario, const st
   if (degree) options.degree = *degree;  // else the library's defaults
   if (segment) options.segment_s = *segment;
   std::string json;
-  std::vector<sim::QuadrotorTruth> states;
+  std::vector<estim::QuadrotorTruth> states;
   {
     py::gil_scoped_release release;
-    sim::QuadrotorData data;
+    estim::QuadrotorData data;
     if (data_folder) {
-      data = sim::ReadQuadrotorData(*data_folder);
+      data = estim::ReadQuadrotorData(*data_folder);
       if (vehicle) data.vehicle = estim::ReadVehicle(*vehicle);  // replaces the folder's, as --vehicle does
     } else {
       data = sim::SimulateQuadrotor(estim::ReadVehicle(*vehicle), SimOptionsOf(*scenario, seed, duration));
     }
     const estim::QuadrotorEstimate e = estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial,
-                                                                options, sim::ReportTimes(data));
-    std::optional<sim::QuadrotorErrors> errors;
-    if (!data.truth.empty()) errors = sim::CompareWithTruth(e, data.truth);
-    json = sim::QuadrotorEstimateJson(e, errors ? &*errors : nullptr);
-    states = sim::EstimatedStates(e);
+                                                                options, estim::ReportTimes(data));
+    std::optional<estim::QuadrotorErrors> errors;
+    if (!data.truth.empty()) errors = estim::CompareWithTruth(e, data.truth);
+    json = estim::QuadrotorEstimateJson(e, errors ? &*errors : nullptr);
+    states = estim::EstimatedStates(e);
   }
   const auto n = static_cast<Eigen::Index>(states.size());
   std::vector<double> t(states.size());
   Eigen::MatrixXd p(n, 3), q(n, 4), v(n, 3), w(n, 3), rotor(n, 4);
   for (Eigen::Index i = 0; i < n; ++i) {
-    const sim::QuadrotorTruth& s = states[static_cast<size_t>(i)];
+    const estim::QuadrotorTruth& s = states[static_cast<size_t>(i)];
     t[static_cast<size_t>(i)] = s.t;
     p.row(i) = s.p.transpose();
     q.row(i) << s.q.x(), s.q.y(), s.q.z(), s.q.w();

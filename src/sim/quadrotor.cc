@@ -4,19 +4,13 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <numbers>
 #include <random>
-#include <sstream>
-
-#include <nlohmann/json.hpp>
 
 #include "cheval/common/error.h"
+#include "cheval/common/options.h"
 #include "cheval/lie/so3.h"
-#include "cheval/traj/io.h"
 
 namespace cheval::sim {
 namespace {
@@ -247,7 +241,7 @@ class Simulator {
   Eigen::Vector3d k_R_, k_w_;
 };
 
-QuadrotorTruth ToTruth(const State& s, double t) { return {t, s.p, s.q, s.v, s.w, s.rotor}; }
+estim::QuadrotorTruth ToTruth(const State& s, double t) { return {t, s.p, s.q, s.v, s.w, s.rotor}; }
 
 // Landmarks on the faces of the room [-10, 10]² x [0, 6], uniform in area.
 std::vector<Eigen::Vector3d> MakeLandmarks(int count, Gaussian& random) {
@@ -267,10 +261,6 @@ std::vector<Eigen::Vector3d> MakeLandmarks(int count, Gaussian& random) {
     }
   }
   return points;
-}
-
-void Require(bool ok, const std::string& message) {
-  if (!ok) throw UsageError(message);
 }
 
 }  // namespace
@@ -308,16 +298,29 @@ std::optional<Eigen::Vector2d> Project(const estim::PinholeCamera& camera, const
   return uv;
 }
 
-QuadrotorData SimulateQuadrotor(const estim::Vehicle& vehicle, const QuadrotorSimOptions& options) {
+void QuadrotorSimOptions::Validate() const {
+  const OptionCheck check("QuadrotorSimOptions");
+  check(std::isfinite(duration_s) && duration_s > 0 && duration_s <= 3600, "duration_s", "must be in (0, 3600] s, got {}",
+        duration_s);
+  check(integration_rate_hz >= 100 && integration_rate_hz <= 1e5, "integration_rate_hz",
+        "must be in [100, 1e5] Hz, got {}", integration_rate_hz);
+  check(truth_rate_hz > 0 && truth_rate_hz <= integration_rate_hz, "truth_rate_hz",
+        "must be in (0, integration_rate_hz = {}] Hz, got {}", integration_rate_hz, truth_rate_hz);
+  check(landmarks > 0, "landmarks", "must be > 0, got {}", landmarks);
+  check(max_features_per_frame > 0, "max_features_per_frame", "must be > 0, got {}", max_features_per_frame);
+  const auto non_negative = [&](double value, std::string_view field) {
+    check(std::isfinite(value) && value >= 0, field, "must be a finite number >= 0, got {}", value);
+  };
+  non_negative(vo_position_noise_m, "vo_position_noise_m");
+  non_negative(vo_rotation_noise_rad, "vo_rotation_noise_rad");
+  non_negative(vo_position_drift_m_per_sqrt_s, "vo_position_drift_m_per_sqrt_s");
+  non_negative(vo_rotation_drift_rad_per_sqrt_s, "vo_rotation_drift_rad_per_sqrt_s");
+}
+
+estim::QuadrotorData SimulateQuadrotor(const estim::Vehicle& vehicle, const QuadrotorSimOptions& options) {
+  options.Validate();
   estim::ValidateVehicle(vehicle, "<vehicle>");
-  Require(std::isfinite(options.duration_s) && options.duration_s > 0 && options.duration_s <= 3600,
-          fmt::format("--duration must be in (0, 3600] s, got {}", options.duration_s));
-  Require(options.integration_rate_hz >= 100 && options.integration_rate_hz <= 1e5,
-          "the integration rate must be in [100, 1e5] Hz");
-  Require(options.truth_rate_hz > 0 && options.truth_rate_hz <= options.integration_rate_hz,
-          "the truth rate must be in (0, integration rate]");
-  Require(options.landmarks > 0 && options.max_features_per_frame > 0, "landmarks and features must be > 0");
-  QuadrotorData data;
+  estim::QuadrotorData data;
   data.vehicle = vehicle;
   Gaussian landmark_random(options.seed, 1), pixel_random(options.seed, 2), vo_random(options.seed, 3),
       pick_random(options.seed, 4);
@@ -355,7 +358,7 @@ QuadrotorData SimulateQuadrotor(const estim::Vehicle& vehicle, const QuadrotorSi
       std::swap(visible[i], visible[j]);
       std::swap(uvs[i], uvs[j]);
     }
-    std::vector<PixelMeasurement> seen;
+    std::vector<estim::PixelObservation> seen;
     for (int i = 0; i < keep; ++i) {
       const Eigen::Vector2d noise(pixel_random.Normal(), pixel_random.Normal());
       seen.push_back({t, visible[i], uvs[i] + camera.pixel_noise_px * noise});
@@ -390,193 +393,6 @@ QuadrotorData SimulateQuadrotor(const estim::Vehicle& vehicle, const QuadrotorSi
   if (data.saturated_steps > steps / 100) {
     throw ComputeError(fmt::format("the vehicle cannot fly scenario '{}': rotor commands saturated in {} of {} steps",
                                    ToString(options.scenario), data.saturated_steps, steps));
-  }
-  return data;
-}
-
-QuadrotorErrors CompareWithTruth(const estim::QuadrotorEstimate& estimate, const std::vector<QuadrotorTruth>& truth) {
-  QuadrotorErrors e;
-  Eigen::Vector4d abs_sum = Eigen::Vector4d::Zero(), true_sum = Eigen::Vector4d::Zero();
-  double p2 = 0, r2 = 0, v2 = 0;
-  size_t k = 0;
-  for (const estim::QuadrotorStateEstimate& s : estimate.samples) {
-    while (k < truth.size() && truth[k].t < s.t - 1e-9) ++k;
-    if (k == truth.size()) break;
-    if (std::abs(truth[k].t - s.t) > 1e-9) continue;
-    const QuadrotorTruth& g = truth[k];
-    abs_sum += (s.rotor - g.rotor).cwiseAbs();
-    true_sum += g.rotor;
-    p2 += (s.p - g.p).squaredNorm();
-    v2 += (s.v - g.v).squaredNorm();
-    const double angle = lie::SO3d(Eigen::Matrix3d(s.R.transpose() * g.q.toRotationMatrix())).Log().norm();
-    r2 += angle * angle;
-    ++e.samples;
-  }
-  if (e.samples == 0) throw ComputeError("the estimate and the ground truth share no time");
-  const double n = e.samples;
-  e.rotor_error_rpm = abs_sum / n * 60.0 / (2 * kPi);
-  e.rotor_error_percent = 100.0 * abs_sum.cwiseQuotient(true_sum);
-  e.position_rmse_m = std::sqrt(p2 / n);
-  e.rotation_rmse_deg = std::sqrt(r2 / n) * 180.0 / kPi;
-  e.velocity_rmse_mps = std::sqrt(v2 / n);
-  return e;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Data folder.
-
-namespace {
-
-std::string Num(double x) { return fmt::format("{:.17g}", x); }
-
-void WriteText(const std::filesystem::path& path, const std::string& text) {
-  traj::WriteFileAtomically(path.string(), text);
-}
-
-// Rows of a CSV file with a header line; every row must have `columns` numbers.
-std::vector<std::vector<double>> ReadCsv(const std::filesystem::path& path, size_t columns) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string(), 0, 0, "cannot open (required file of a quadrotor data folder)");
-  std::vector<std::vector<double>> rows;
-  std::string line;
-  int64_t number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (line.empty() || line[0] == '#' || (number == 1 && !std::isdigit(static_cast<unsigned char>(line[0])) &&
-                                           line[0] != '-' && line[0] != '.')) {
-      continue;
-    }
-    std::vector<double> row;
-    const char* p = line.data();
-    const char* end = line.data() + line.size();
-    while (p < end) {
-      double value = 0;
-      const auto [next, ec] = std::from_chars(p, end, value);
-      if (ec != std::errc() || !std::isfinite(value)) {
-        throw InputError(path.string(), number, p - line.data() + 1, "expected a finite number");
-      }
-      row.push_back(value);
-      p = next;
-      if (p < end && *p == ',') ++p;
-      else if (p < end) throw InputError(path.string(), number, p - line.data() + 1, "expected ','");
-    }
-    if (row.size() != columns) {
-      throw InputError(path.string(), number, 1, fmt::format("expected {} fields, got {}", columns, row.size()));
-    }
-    rows.push_back(std::move(row));
-  }
-  return rows;
-}
-
-}  // namespace
-
-void WriteQuadrotorData(const QuadrotorData& data, const std::string& folder) {
-  const std::filesystem::path dir(folder);
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw OutputError(fmt::format("{}: error: cannot create folder: {}", folder, ec.message()));
-  WriteText(dir / "vehicle.json", estim::VehicleToJson(data.vehicle));
-  std::string text = "id,x,y,z\n";
-  for (size_t i = 0; i < data.landmarks.size(); ++i) {
-    const Eigen::Vector3d& x = data.landmarks[i];
-    text += fmt::format("{},{},{},{}\n", i, Num(x.x()), Num(x.y()), Num(x.z()));
-  }
-  WriteText(dir / "landmarks.csv", text);
-  text = "t,landmark,u,v\n";
-  for (const PixelMeasurement& m : data.pixels) {
-    text += fmt::format("{},{},{},{}\n", Num(m.t), m.landmark, Num(m.uv.x()), Num(m.uv.y()));
-  }
-  WriteText(dir / "measurements.csv", text);
-  text = "t,px,py,pz,qw,qx,qy,qz\n";
-  for (const PoseSample& s : data.initial) {
-    text += fmt::format("{},{},{},{},{},{},{},{}\n", Num(s.t), Num(s.p.x()), Num(s.p.y()), Num(s.p.z()), Num(s.q.w()),
-                        Num(s.q.x()), Num(s.q.y()), Num(s.q.z()));
-  }
-  WriteText(dir / "initial.csv", text);
-  if (!data.truth.empty()) WriteText(dir / "truth.csv", QuadrotorStatesCsv(data.truth));
-}
-
-std::vector<double> ReportTimes(const QuadrotorData& data) {
-  std::vector<double> times;
-  for (const QuadrotorTruth& t : data.truth) times.push_back(t.t);
-  if (times.empty() && !data.initial.empty()) {
-    const double first = data.initial.front().t, last = data.initial.back().t;
-    for (int64_t k = 0; first + 0.01 * static_cast<double>(k) <= last; ++k) {
-      times.push_back(first + 0.01 * static_cast<double>(k));
-    }
-  }
-  return times;
-}
-
-std::vector<QuadrotorTruth> EstimatedStates(const estim::QuadrotorEstimate& estimate) {
-  std::vector<QuadrotorTruth> states;
-  states.reserve(estimate.samples.size());
-  for (const estim::QuadrotorStateEstimate& s : estimate.samples) {
-    states.push_back({s.t, s.p, Eigen::Quaterniond(s.R).normalized(), s.v, s.w, s.rotor});
-  }
-  return states;
-}
-
-std::string QuadrotorStatesCsv(const std::vector<QuadrotorTruth>& states) {
-  std::string text = "t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,rotor0,rotor1,rotor2,rotor3\n";
-  for (const QuadrotorTruth& s : states) {
-    text += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", Num(s.t), Num(s.p.x()), Num(s.p.y()),
-                        Num(s.p.z()), Num(s.q.w()), Num(s.q.x()), Num(s.q.y()), Num(s.q.z()), Num(s.v.x()),
-                        Num(s.v.y()), Num(s.v.z()), Num(s.w.x()), Num(s.w.y()), Num(s.w.z()), Num(s.rotor[0]),
-                        Num(s.rotor[1]), Num(s.rotor[2]), Num(s.rotor[3]));
-  }
-  return text;
-}
-
-std::string QuadrotorEstimateJson(const estim::QuadrotorEstimate& e, const QuadrotorErrors* errors) {
-  nlohmann::ordered_json j = {{"states", e.states},         {"segments", e.segments}, {"degree", e.degree},
-                              {"iterations", e.iterations}, {"seconds", e.seconds},   {"converged", e.converged}};
-  if (errors != nullptr) {
-    auto four = [](const Eigen::Vector4d& v) { return nlohmann::ordered_json::array({v[0], v[1], v[2], v[3]}); };
-    j["rotor_error_rpm"] = four(errors->rotor_error_rpm);
-    j["rotor_error_percent"] = four(errors->rotor_error_percent);
-    j["position_rmse_m"] = errors->position_rmse_m;
-    j["rotation_rmse_deg"] = errors->rotation_rmse_deg;
-    j["velocity_rmse_mps"] = errors->velocity_rmse_mps;
-  }
-  return j.dump(2) + "\n";
-}
-
-QuadrotorData ReadQuadrotorData(const std::string& folder) {
-  const std::filesystem::path dir(folder);
-  if (!std::filesystem::is_directory(dir)) throw InputError(folder, 0, 0, "not a folder (expected a quadrotor data folder)");
-  QuadrotorData data;
-  data.vehicle = estim::ReadVehicle((dir / "vehicle.json").string());
-  for (const auto& row : ReadCsv(dir / "landmarks.csv", 4)) {
-    if (row[0] != static_cast<double>(data.landmarks.size())) {
-      throw InputError((dir / "landmarks.csv").string(), static_cast<int64_t>(data.landmarks.size()) + 2, 1,
-                       "landmark ids must be 0, 1, 2, ... in order");
-    }
-    data.landmarks.emplace_back(row[1], row[2], row[3]);
-  }
-  int64_t line = 1;
-  for (const auto& row : ReadCsv(dir / "measurements.csv", 4)) {
-    ++line;
-    const int id = static_cast<int>(row[1]);
-    if (row[1] != id || id < 0 || id >= static_cast<int>(data.landmarks.size())) {
-      throw InputError((dir / "measurements.csv").string(), line, 1, fmt::format("unknown landmark id {}", row[1]));
-    }
-    if (!data.pixels.empty() && row[0] < data.pixels.back().t) {
-      throw InputError((dir / "measurements.csv").string(), line, 1, "measurement times must not decrease");
-    }
-    data.pixels.push_back({row[0], id, Eigen::Vector2d(row[2], row[3])});
-  }
-  for (const auto& row : ReadCsv(dir / "initial.csv", 8)) {
-    data.initial.push_back({row[0], Eigen::Vector3d(row[1], row[2], row[3]),
-                            Eigen::Quaterniond(row[4], row[5], row[6], row[7]).normalized()});
-  }
-  if (data.initial.size() < 2) throw InputError((dir / "initial.csv").string(), 0, 0, "needs at least 2 poses");
-  if (std::filesystem::exists(dir / "truth.csv")) {
-    for (const auto& r : ReadCsv(dir / "truth.csv", 18)) {
-      data.truth.push_back({r[0], Eigen::Vector3d(r[1], r[2], r[3]), Eigen::Quaterniond(r[4], r[5], r[6], r[7]).normalized(),
-                            Eigen::Vector3d(r[8], r[9], r[10]), Eigen::Vector3d(r[11], r[12], r[13]),
-                            Eigen::Vector4d(r[14], r[15], r[16], r[17])});
-    }
   }
   return data;
 }

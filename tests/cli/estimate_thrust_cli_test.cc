@@ -37,7 +37,7 @@ void WriteSimulatedDido(const std::string& csv, const std::string& params) {
   sim::QuadrotorSimOptions options;
   options.scenario = sim::QuadrotorScenario::kFigureEight;
   options.duration_s = 4.0;
-  const sim::QuadrotorData data = sim::SimulateQuadrotor(vehicle, options);
+  const estim::QuadrotorData data = sim::SimulateQuadrotor(vehicle, options);
   const double unit = 1e4 * std::numbers::pi / 30;  // DIDO's rotor unit, 1e4 rpm, in rad/s
   estim::ThrustParameters k;
   k.thrust_per_mass = vehicle.quadrotor.thrust_coefficient / vehicle.quadrotor.mass_kg;
@@ -45,7 +45,7 @@ void WriteSimulatedDido(const std::string& csv, const std::string& params) {
   const estim::ThrustModel model{k};
   std::ofstream out(csv);
   out << kHeader << "\n";
-  for (const sim::QuadrotorTruth& s : data.truth) {
+  for (const estim::QuadrotorTruth& s : data.truth) {
     const Eigen::Matrix3d R = s.q.toRotationMatrix();
     const Eigen::Vector4d rpm = s.rotor * 30 / std::numbers::pi;
     const Eigen::Vector3d a = model.Acceleration<double>(s.v, std::sqrt(0.25 * s.rotor.squaredNorm()), R);

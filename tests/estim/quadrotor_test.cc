@@ -11,7 +11,9 @@
 
 #include "cheval/common/error.h"
 #include "cheval/estim/models.h"
+#include "cheval/estim/quadrotor_data.h"
 #include "cheval/estim/quadrotor_estimator.h"
+#include "cheval/estim/quadrotor_scoring.h"
 #include "cheval/estim/thrust_vector_prior.h"
 #include "cheval/estim/vehicle.h"
 #include "cheval/lie/so3.h"
@@ -98,7 +100,7 @@ TEST(QuadrotorSim, TruthIsConsistentAndDeterministic) {
   sim::QuadrotorSimOptions options;
   options.scenario = sim::QuadrotorScenario::kFigureEight;
   options.duration_s = 3.0;
-  const sim::QuadrotorData a = sim::SimulateQuadrotor(v, options), b = sim::SimulateQuadrotor(v, options);
+  const estim::QuadrotorData a = sim::SimulateQuadrotor(v, options), b = sim::SimulateQuadrotor(v, options);
   ASSERT_EQ(a.truth.size(), 301u);
   EXPECT_EQ(a.initial.size(), 91u);  // 30 Hz over 3 s, both ends
   ASSERT_EQ(a.pixels.size(), b.pixels.size());
@@ -120,18 +122,18 @@ TEST(QuadrotorSim, DataFolderRoundTripAndMissingFiles) {
   const estim::Vehicle v = estim::ReadVehicle(kVehicle);
   sim::QuadrotorSimOptions options;
   options.duration_s = 1.0;
-  const sim::QuadrotorData data = sim::SimulateQuadrotor(v, options);
+  const estim::QuadrotorData data = sim::SimulateQuadrotor(v, options);
   const fs::path dir = fs::temp_directory_path() / "cheval_quadrotor_roundtrip";
   fs::remove_all(dir);
-  sim::WriteQuadrotorData(data, dir.string());
-  const sim::QuadrotorData back = sim::ReadQuadrotorData(dir.string());
+  estim::WriteQuadrotorData(data, dir.string());
+  const estim::QuadrotorData back = estim::ReadQuadrotorData(dir.string());
   ASSERT_EQ(back.pixels.size(), data.pixels.size());
   EXPECT_EQ(back.pixels.back().uv, data.pixels.back().uv);  // %.17g round-trips doubles exactly
   EXPECT_EQ(back.truth.back().rotor, data.truth.back().rotor);
   EXPECT_EQ(back.landmarks.size(), data.landmarks.size());
   fs::remove(dir / "measurements.csv");
   try {
-    sim::ReadQuadrotorData(dir.string());
+    estim::ReadQuadrotorData(dir.string());
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("measurements.csv:0:0: error: cannot open"), std::string::npos) << e.what();
@@ -141,7 +143,7 @@ TEST(QuadrotorSim, DataFolderRoundTripAndMissingFiles) {
 
 // A simulated 4 s flight (seed 1) and the truth's times, where the estimate is reported.
 struct Flight {
-  sim::QuadrotorData data;
+  estim::QuadrotorData data;
   std::vector<double> times;
 };
 Flight FourSecondFlight(const estim::Vehicle& v, sim::QuadrotorScenario scenario) {
@@ -160,13 +162,13 @@ TEST(QuadrotorEstimator, RecoversRotorSpeedsFromTheCamera) {
   const estim::Vehicle v = estim::ReadVehicle(kVehicle);
   for (sim::QuadrotorScenario scenario : {sim::QuadrotorScenario::kHover, sim::QuadrotorScenario::kFigureEight}) {
     const Flight flight = FourSecondFlight(v, scenario);
-    const sim::QuadrotorData& data = flight.data;
+    const estim::QuadrotorData& data = flight.data;
     const std::vector<double>& times = flight.times;
     const estim::QuadrotorEstimate e =
         estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, {}, times);
     EXPECT_TRUE(e.converged) << e.solver_report;
     EXPECT_EQ(e.states, e.segments * e.degree + 1);
-    const sim::QuadrotorErrors errors = sim::CompareWithTruth(e, data.truth);
+    const estim::QuadrotorErrors errors = estim::CompareWithTruth(e, data.truth);
     EXPECT_EQ(errors.samples, 401);
     EXPECT_LT(errors.rotor_error_percent.maxCoeff(), 1.0) << sim::ToString(scenario);
     EXPECT_LT(errors.position_rmse_m, 0.01);
@@ -195,15 +197,15 @@ TEST(QuadrotorEstimator, FlatnessInitialStateRecoversAKnownFlight) {
   sim::QuadrotorSimOptions options;
   options.scenario = sim::QuadrotorScenario::kFigureEight;
   options.duration_s = 4.0;
-  const sim::QuadrotorData data = sim::SimulateQuadrotor(v, options);
+  const estim::QuadrotorData data = sim::SimulateQuadrotor(v, options);
   std::vector<estim::PoseSample> poses;
-  for (const sim::PoseSample& frame : data.initial) {
+  for (const estim::PoseSample& frame : data.initial) {
     const size_t i = static_cast<size_t>(std::lround(frame.t * 100));
     if (std::abs(data.truth[i].t - frame.t) < 1e-9) poses.push_back({frame.t, data.truth[i].p, data.truth[i].q});
   }
   ASSERT_EQ(poses.size(), 41u);
   double worst_rotor = 0, worst_hover = 0;
-  for (const sim::QuadrotorTruth& truth : data.truth) {
+  for (const estim::QuadrotorTruth& truth : data.truth) {
     const estim::QuadrotorStateEstimate x0 = estim::FlatnessInitialState(v.quadrotor, poses, truth.t, 0.6);
     const bool inside = truth.t >= 0.3 && truth.t <= 3.7;
     for (int i = 0; i < 4; ++i) {
@@ -270,7 +272,7 @@ TEST(QuadrotorEstimator, AdaptiveRotorPriorBeatsOneFixedSigma) {
   const estim::Vehicle v = estim::ReadVehicle(kVehicle);
   for (sim::QuadrotorScenario scenario : {sim::QuadrotorScenario::kHover, sim::QuadrotorScenario::kAggressive}) {
     const Flight flight = FourSecondFlight(v, scenario);
-    const sim::QuadrotorData& data = flight.data;
+    const estim::QuadrotorData& data = flight.data;
     const std::vector<double>& times = flight.times;
     estim::QuadrotorEstimateOptions fixed, random_walk;
     fixed.adaptive_rotor_prior = false;
@@ -280,9 +282,9 @@ TEST(QuadrotorEstimator, AdaptiveRotorPriorBeatsOneFixedSigma) {
     const estim::QuadrotorEstimate r =
         estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, random_walk, times);
     EXPECT_TRUE(a.converged) << a.solver_report;
-    const double adaptive_error = sim::CompareWithTruth(a, data.truth).rotor_error_percent.maxCoeff();
-    const double fixed_error = sim::CompareWithTruth(f, data.truth).rotor_error_percent.maxCoeff();
-    const double random_walk_error = sim::CompareWithTruth(r, data.truth).rotor_error_percent.maxCoeff();
+    const double adaptive_error = estim::CompareWithTruth(a, data.truth).rotor_error_percent.maxCoeff();
+    const double fixed_error = estim::CompareWithTruth(f, data.truth).rotor_error_percent.maxCoeff();
+    const double random_walk_error = estim::CompareWithTruth(r, data.truth).rotor_error_percent.maxCoeff();
     if (scenario == sim::QuadrotorScenario::kHover) {
       EXPECT_LT(adaptive_error, 0.5 * fixed_error);
     } else {
@@ -296,7 +298,7 @@ TEST(QuadrotorEstimator, AdaptiveRotorPriorBeatsOneFixedSigma) {
   bad.pilot_iterations = 0;
   sim::QuadrotorSimOptions options;
   options.duration_s = 1.0;
-  const sim::QuadrotorData data = sim::SimulateQuadrotor(v, options);
+  const estim::QuadrotorData data = sim::SimulateQuadrotor(v, options);
   EXPECT_THROW(estim::EstimateQuadrotor(v, data.landmarks, data.pixels, data.initial, bad, {}), UsageError);
   bad = {};
   bad.adaptive_rotor_prior_floor = 0;
@@ -311,9 +313,9 @@ TEST(QuadrotorEstimator, AdaptiveRotorPriorBeatsOneFixedSigma) {
 TEST(QuadrotorEstimator, ThrustPriorVariantsRunAndValidate) {
   const estim::Vehicle v = estim::ReadVehicle(kVehicle);
   const Flight flight = FourSecondFlight(v, sim::QuadrotorScenario::kAggressive);
-  const sim::QuadrotorData& data = flight.data;
+  const estim::QuadrotorData& data = flight.data;
   const estim::QuadrotorEstimate d = estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, {}, flight.times);
-  const double default_error = sim::CompareWithTruth(d, data.truth).rotor_error_percent.maxCoeff();
+  const double default_error = estim::CompareWithTruth(d, data.truth).rotor_error_percent.maxCoeff();
   for (int variant = 0; variant < 3; ++variant) {
     estim::QuadrotorEstimateOptions o;
     if (variant == 0) o.thrust_prior_rounds = 2;
@@ -321,7 +323,7 @@ TEST(QuadrotorEstimator, ThrustPriorVariantsRunAndValidate) {
     if (variant == 2) o.motion_prior = true;
     const estim::QuadrotorEstimate e = estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, o, flight.times);
     EXPECT_TRUE(e.converged) << variant << ": " << e.solver_report;
-    const double error = sim::CompareWithTruth(e, data.truth).rotor_error_percent.maxCoeff();
+    const double error = estim::CompareWithTruth(e, data.truth).rotor_error_percent.maxCoeff();
     std::printf("variant %d: %.3f %% (default %.3f %%), %d iterations\n", variant, error, default_error, e.iterations);
     EXPECT_LT(std::abs(error - default_error), 0.1) << variant;
   }
@@ -394,7 +396,7 @@ TEST(QuadrotorEstimator, BadInputIsAnError) {
   const estim::Vehicle v = estim::ReadVehicle(kVehicle);
   sim::QuadrotorSimOptions options;
   options.duration_s = 1.0;
-  sim::QuadrotorData data = sim::SimulateQuadrotor(v, options);
+  estim::QuadrotorData data = sim::SimulateQuadrotor(v, options);
   // Initial poses that do not cover the measurements.
   std::vector<estim::PoseSample> short_initial(data.initial.begin(), data.initial.begin() + 10);
   EXPECT_THROW(estim::EstimateQuadrotor(v, data.landmarks, data.pixels, short_initial, {}, {}), ComputeError);

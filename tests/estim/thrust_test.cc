@@ -38,11 +38,11 @@ estim::ThrustFlight SimulatedFlight(sim::QuadrotorScenario scenario, double dura
   sim::QuadrotorSimOptions options;
   options.scenario = scenario;
   options.duration_s = duration_s;
-  const sim::QuadrotorData data = sim::SimulateQuadrotor(vehicle, options);
+  const estim::QuadrotorData data = sim::SimulateQuadrotor(vehicle, options);
   estim::ThrustFlight flight;
   flight.parameters = FromQuadrotor(vehicle.quadrotor);
   const estim::ThrustModel model{flight.parameters};
-  for (const sim::QuadrotorTruth& truth : data.truth) {
+  for (const estim::QuadrotorTruth& truth : data.truth) {
     estim::ThrustSample s;
     s.t = truth.t;
     s.p = truth.p;

@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "cheval/common/error.h"
+#include "cheval/estim/quadrotor_data.h"
 #include "cheval/estim/quadrotor_estimator.h"
+#include "cheval/estim/quadrotor_scoring.h"
 #include "cheval/sim/quadrotor.h"
 #include "cheval/traj/io.h"
 #include "common.h"
@@ -78,8 +80,8 @@ void RegisterSimQuadrotor(CLI::App& app, Action* action) {
   quad->callback([flags, action] {
     *action = [flags] {
       const estim::Vehicle vehicle = estim::ReadVehicle(flags->vehicle);
-      const sim::QuadrotorData data = sim::SimulateQuadrotor(vehicle, SimOptions(*flags));
-      sim::WriteQuadrotorData(data, flags->output);
+      const estim::QuadrotorData data = sim::SimulateQuadrotor(vehicle, SimOptions(*flags));
+      estim::WriteQuadrotorData(data, flags->output);
       if (!Quiet()) fmt::print(stderr, "wrote {} ({} s, seed {}): {} frames, {} pixel measurements, {} landmarks, {} truth samples to {}\n",
                  flags->scenario, flags->duration_s, flags->seed, data.initial.size(), data.pixels.size(),
                  data.landmarks.size(), data.truth.size(), flags->output);
@@ -109,15 +111,15 @@ void RegisterEstimate(CLI::App& app, Action* action) {
     const bool has_vehicle = quad->get_option("--vehicle")->count() > 0;
     *action = [flags, has_scenario, has_data, has_vehicle] {
       if (has_scenario == has_data) throw UsageError("give exactly one of --scenario NAME or --data DIR");
-      sim::QuadrotorData data;
+      estim::QuadrotorData data;
       if (has_data) {
-        data = sim::ReadQuadrotorData(flags->data);
+        data = estim::ReadQuadrotorData(flags->data);
         // An explicit --vehicle replaces the folder's vehicle.json (e.g. to study a wrong model).
         if (has_vehicle) data.vehicle = estim::ReadVehicle(flags->vehicle);
       } else {
         data = sim::SimulateQuadrotor(estim::ReadVehicle(flags->vehicle), SimOptions(*flags));
       }
-      const std::vector<double> times = sim::ReportTimes(data);  // the truth's, else every 10 ms
+      const std::vector<double> times = estim::ReportTimes(data);  // the truth's, else every 10 ms
       estim::QuadrotorEstimateOptions options = flags->options;
       options.progress = Progress().Fn();  // on a terminal only
       const estim::QuadrotorEstimate e =
@@ -127,9 +129,9 @@ void RegisterEstimate(CLI::App& app, Action* action) {
                  e.degree);
       fmt::print("solver iterations   {}{}\nseconds             {:.3f}\n", e.iterations,
                  e.converged ? "" : "  (did not converge)", e.seconds);
-      std::optional<sim::QuadrotorErrors> errors;
+      std::optional<estim::QuadrotorErrors> errors;
       if (!data.truth.empty()) {
-        errors = sim::CompareWithTruth(e, data.truth);
+        errors = estim::CompareWithTruth(e, data.truth);
         const Eigen::Vector4d& rpm = errors->rotor_error_rpm;
         const Eigen::Vector4d& percent = errors->rotor_error_percent;
         fmt::print("rotor error rpm     {:.2f} {:.2f} {:.2f} {:.2f}\n", rpm[0], rpm[1], rpm[2], rpm[3]);
@@ -141,8 +143,8 @@ void RegisterEstimate(CLI::App& app, Action* action) {
       }
       if (!e.converged) fmt::print(stderr, "cheval: warning: the solver did not converge: {}\n", e.solver_report);
       // Both outputs are formatted before either is written.
-      const std::string json = sim::QuadrotorEstimateJson(e, errors ? &*errors : nullptr);
-      const std::string states = flags->states_output.empty() ? "" : sim::QuadrotorStatesCsv(sim::EstimatedStates(e));
+      const std::string json = estim::QuadrotorEstimateJson(e, errors ? &*errors : nullptr);
+      const std::string states = flags->states_output.empty() ? "" : estim::QuadrotorStatesCsv(estim::EstimatedStates(e));
       std::vector<traj::FileToWrite> files;
       if (!flags->states_output.empty()) files.push_back({flags->states_output, states});
       if (!flags->json.empty()) files.push_back({flags->json, json});

@@ -15,7 +15,7 @@
 #include <string_view>
 #include <vector>
 
-#include "cheval/estim/quadrotor_estimator.h"
+#include "cheval/estim/quadrotor_data.h"
 #include "cheval/estim/vehicle.h"
 
 namespace cheval::sim {
@@ -30,7 +30,7 @@ std::optional<QuadrotorScenario> QuadrotorScenarioFromString(std::string_view na
 /// Every scenario, in order of complexity.
 std::vector<QuadrotorScenario> AllQuadrotorScenarios();
 
-/// What to simulate. Validated by SimulateQuadrotor (UsageError naming the option).
+/// What to simulate. SimulateQuadrotor calls Validate().
 struct QuadrotorSimOptions {
   QuadrotorScenario scenario = QuadrotorScenario::kHover;
   uint64_t seed = 1;                       ///< landmarks, pixel noise and front-end noise
@@ -43,79 +43,22 @@ struct QuadrotorSimOptions {
   double vo_rotation_noise_rad = 0.005;    ///< white noise of its orientations (right perturbation)
   double vo_position_drift_m_per_sqrt_s = 0.05;     ///< random-walk drift of its positions
   double vo_rotation_drift_rad_per_sqrt_s = 0.01;   ///< random-walk drift of its orientations
+
+  /// Throws OptionError naming the first field out of range: duration_s in (0, 3600],
+  /// integration_rate_hz in [100, 1e5], truth_rate_hz in (0, integration_rate_hz], landmarks and
+  /// max_features_per_frame > 0, the four front-end noise and drift levels finite and >= 0.
+  void Validate() const;
 };
 
-/// The exact state of the vehicle at one time.
-struct QuadrotorTruth {
-  double t = 0;                    ///< s
-  Eigen::Vector3d p;               ///< position, world, m
-  Eigen::Quaterniond q;            ///< R_world_body
-  Eigen::Vector3d v;               ///< velocity, world, m/s
-  Eigen::Vector3d w;               ///< body rate, rad/s
-  Eigen::Vector4d rotor;           ///< rotor speeds Ω_0..3, rad/s
-};
-
-/// One pixel measurement of a landmark (index into QuadrotorData::landmarks).
-using PixelMeasurement = estim::PixelObservation;
-/// A pose of the initial trajectory (front end), at a frame time.
-using PoseSample = estim::PoseSample;
-
-/// Errors of an estimate against the ground truth at the truth samples inside the estimated interval.
-struct QuadrotorErrors {
-  int samples = 0;
-  Eigen::Vector4d rotor_error_rpm = Eigen::Vector4d::Zero();      ///< mean |Ω̂_i − Ω_i| per motor, rpm
-  Eigen::Vector4d rotor_error_percent = Eigen::Vector4d::Zero();  ///< the same, % of the motor's mean true speed
-  double position_rmse_m = 0, rotation_rmse_deg = 0, velocity_rmse_mps = 0;
-};
-
-/// Compares an estimate with the truth at the truth samples (the estimate is re-interpolated there:
-/// pass the truth times as query times to EstimateQuadrotor). ComputeError when no sample overlaps.
-QuadrotorErrors CompareWithTruth(const estim::QuadrotorEstimate& estimate, const std::vector<QuadrotorTruth>& truth);
-
-/// Everything the estimator gets (vehicle, landmarks, measurements, initial poses) and, for
-/// evaluation only, the ground truth (empty when a data folder has none).
-struct QuadrotorData {
-  estim::Vehicle vehicle;
-  std::vector<Eigen::Vector3d> landmarks;
-  std::vector<PixelMeasurement> pixels;  ///< sorted by time
-  std::vector<PoseSample> initial;       ///< one per camera frame
-  std::vector<QuadrotorTruth> truth;     ///< at truth_rate_hz
-  int saturated_steps = 0;               ///< RK4 steps where a rotor command hit 0 or the limit
-};
-
-/// Simulates a flight. Throws UsageError for bad options, ComputeError if the vehicle cannot fly
-/// the scenario (a command beyond the rotor limit for more than 1 % of the steps).
-QuadrotorData SimulateQuadrotor(const estim::Vehicle& vehicle, const QuadrotorSimOptions& options);
+/// Simulates a flight: the estimator's input (estim/quadrotor_data.h) with its ground truth at
+/// truth_rate_hz. Throws OptionError for bad options (Validate), InputError for a bad vehicle,
+/// ComputeError if the vehicle cannot fly the scenario (a command beyond the rotor limit for more
+/// than 1 % of the steps).
+estim::QuadrotorData SimulateQuadrotor(const estim::Vehicle& vehicle, const QuadrotorSimOptions& options);
 
 /// Projects world point `x` seen from pose (p, R_world_body): pixel, or nullopt when behind the
 /// camera (depth < 0.1 m) or outside the image.
 std::optional<Eigen::Vector2d> Project(const estim::PinholeCamera& camera, const Eigen::Vector3d& p,
                                        const Eigen::Matrix3d& R, const Eigen::Vector3d& x);
-
-/// The times an estimate of `data` is reported at: the truth's times when the data has a truth (so
-/// CompareWithTruth can use them), else every 10 ms from the first front-end pose to the last.
-std::vector<double> ReportTimes(const QuadrotorData& data);
-
-/// The states of an estimate in the layout of QuadrotorTruth (its samples, in time order).
-std::vector<QuadrotorTruth> EstimatedStates(const estim::QuadrotorEstimate& estimate);
-
-/// The CSV text of states as truth.csv holds them (docs/estimator.md): header
-/// `t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,rotor0,rotor1,rotor2,rotor3`, numbers with 17
-/// significant digits. `cheval estimate quadrotor -o FILE` writes an estimate this way.
-std::string QuadrotorStatesCsv(const std::vector<QuadrotorTruth>& states);
-
-/// The JSON object of `cheval estimate quadrotor --json` (docs/estimator.md): states, segments,
-/// degree, iterations, seconds, converged and, when `errors` is given, rotor_error_rpm,
-/// rotor_error_percent (4 numbers each), position_rmse_m, rotation_rmse_deg, velocity_rmse_mps.
-/// The Python module returns the same object as a dict.
-std::string QuadrotorEstimateJson(const estim::QuadrotorEstimate& estimate, const QuadrotorErrors* errors);
-
-/// Writes a data folder (docs/estimator.md): vehicle.json, landmarks.csv, measurements.csv,
-/// initial.csv and truth.csv. Creates the folder. OutputError when a file cannot be written.
-void WriteQuadrotorData(const QuadrotorData& data, const std::string& folder);
-
-/// Reads a data folder. truth.csv is optional; every other file is required. InputError naming
-/// the missing or malformed file (and line).
-QuadrotorData ReadQuadrotorData(const std::string& folder);
 
 }  // namespace cheval::sim

@@ -1,0 +1,54 @@
+#pragma once
+/// \file
+/// The quadrotor estimator's input as a data folder (docs/estimator.md, "Data folder"): the vehicle,
+/// the landmarks, the camera's pixel measurements, the front end's initial poses and, for
+/// evaluation only, the ground truth. `cheval sim quadrotor` writes one (sim::SimulateQuadrotor
+/// produces a QuadrotorData); `cheval estimate quadrotor --data` reads one.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "cheval/estim/quadrotor_estimator.h"
+#include "cheval/estim/vehicle.h"
+
+namespace cheval::estim {
+
+/// The state of the vehicle at one time, as truth.csv holds it: the exact state in a simulated
+/// folder, an estimate's state when EstimatedStates (quadrotor_scoring.h) converts one.
+struct QuadrotorTruth {
+  double t = 0;                    ///< s
+  Eigen::Vector3d p;               ///< position, world, m
+  Eigen::Quaterniond q;            ///< R_world_body
+  Eigen::Vector3d v;               ///< velocity, world, m/s
+  Eigen::Vector3d w;               ///< body rate, rad/s
+  Eigen::Vector4d rotor;           ///< rotor speeds Ω_0..3, rad/s
+};
+
+/// Everything the estimator gets (vehicle, landmarks, measurements, initial poses) and, for
+/// evaluation only, the ground truth (empty when a data folder has none).
+struct QuadrotorData {
+  Vehicle vehicle;
+  std::vector<Eigen::Vector3d> landmarks;
+  std::vector<PixelObservation> pixels;  ///< sorted by time; landmark indexes into `landmarks`
+  std::vector<PoseSample> initial;       ///< one per camera frame
+  std::vector<QuadrotorTruth> truth;     ///< at the simulator's truth rate; empty if none
+  int saturated_steps = 0;               ///< simulator only: RK4 steps where a rotor command hit 0 or the limit
+};
+
+/// The CSV text of states as truth.csv holds them (docs/estimator.md): header
+/// `t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,rotor0,rotor1,rotor2,rotor3`, numbers with 17
+/// significant digits. `cheval estimate quadrotor -o FILE` writes an estimate this way.
+std::string QuadrotorStatesCsv(const std::vector<QuadrotorTruth>& states);
+
+/// Writes a data folder (docs/estimator.md): vehicle.json, landmarks.csv, measurements.csv,
+/// initial.csv and, when `data.truth` is not empty, truth.csv. Creates the folder. OutputError
+/// when the folder or a file cannot be written.
+void WriteQuadrotorData(const QuadrotorData& data, const std::string& folder);
+
+/// Reads a data folder. truth.csv is optional; every other file is required. InputError naming
+/// the missing or malformed file (and line).
+QuadrotorData ReadQuadrotorData(const std::string& folder);
+
+}  // namespace cheval::estim
