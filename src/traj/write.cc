@@ -1,18 +1,12 @@
 // Trajectory writers and atomic file output.
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
-#include <filesystem>
-#include <random>
 #include <span>
 #include <vector>
-
-#include <unistd.h>
 
 #include <fmt/compile.h>
 #include <fmt/format.h>
 
 #include "cheval/common/error.h"
+#include "cheval/common/output.h"
 #include "cheval/traj/io.h"
 #include "cheval/traj/stamp.h"
 
@@ -110,64 +104,14 @@ std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
   return out;
 }
 
-namespace {
-
-// Writes `text` to a new temporary file beside `path`, flushed to disk; returns its path. Throws
-// OutputError naming `path` (and leaves no temporary) when it cannot.
-std::filesystem::path StageFile(const std::string& path, std::string_view text) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  const fs::path directory = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  std::random_device entropy;
-  const fs::path temporary =
-      directory / fmt::format(".{}.tmp-{}-{:x}", target.filename().string(), ::getpid(), entropy());
-  std::FILE* file = std::fopen(temporary.c_str(), "wbx");
-  if (file == nullptr) {
-    throw OutputError(fmt::format("{}: error: cannot write: {}", path, std::strerror(errno)));
-  }
-  const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size();
-  const bool flushed = std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
-  const int saved_errno = errno;
-  const bool closed = std::fclose(file) == 0;
-  if (!written || !flushed || !closed) {
-    std::error_code ignored;
-    fs::remove(temporary, ignored);
-    throw OutputError(fmt::format("{}: error: cannot write: {}", path, std::strerror(saved_errno)));
-  }
-  return temporary;
-}
-
-}  // namespace
-
 void WriteFilesAtomically(std::span<const FileToWrite> files) {
-  namespace fs = std::filesystem;
-  std::vector<fs::path> staged;
-  auto remove_staged = [&staged](size_t from) {
-    for (size_t k = from; k < staged.size(); ++k) {
-      std::error_code ignored;
-      fs::remove(staged[k], ignored);
-    }
-  };
-  try {
-    for (const FileToWrite& file : files) staged.push_back(StageFile(file.path, file.text));
-  } catch (...) {
-    remove_staged(0);  // nothing was replaced yet
-    throw;
-  }
-  for (size_t k = 0; k < staged.size(); ++k) {
-    std::error_code error;
-    fs::rename(staged[k], files[k].path, error);
-    if (error) {
-      remove_staged(k);
-      throw OutputError(fmt::format("{}: error: cannot write: {}", files[k].path, error.message()));
-    }
-  }
+  std::vector<OutputFile> outputs;
+  outputs.reserve(files.size());
+  for (const FileToWrite& file : files) outputs.push_back({file.path, file.text});
+  WriteOutputs(outputs);
 }
 
-void WriteFileAtomically(const std::string& path, std::string_view text) {
-  const FileToWrite file{path, text};
-  WriteFilesAtomically(std::span<const FileToWrite>(&file, 1));
-}
+void WriteFileAtomically(const std::string& path, std::string_view text) { WriteOutput(path, text); }
 
 void WriteTrajectory(const std::string& path, const TrajectoryView& trajectory, Format format) {
   WriteFileAtomically(path, FormatTrajectory(trajectory, format));

@@ -98,7 +98,8 @@ std::vector<int64_t> ReadStampsFile(const std::string& path);
 std::string FormatTrajectory(const TrajectoryView& trajectory, Format format);
 
 /// Writes FormatTrajectory() to `path` atomically: a temporary file beside it is written, flushed
-/// and renamed, so a failure leaves no partial file. Throws OutputError.
+/// and renamed, so a failure leaves no partial file. `-`, a FIFO or a device is written in place and a
+/// symlink's target is replaced (cheval/common/output.h, WriteOutputs). Throws OutputError.
 void WriteTrajectory(const std::string& path, const TrajectoryView& trajectory, Format format);
 
 /// Writes `text` to `path` atomically (as WriteTrajectory). Throws OutputError.
@@ -113,7 +114,7 @@ struct FileToWrite {
 /// Writes several files as one: each text goes to a temporary file beside its path first, and only
 /// when every one is on disk are they renamed over their paths. When a file cannot be written none
 /// is replaced (files that existed keep their old content) and no temporary is left. Throws
-/// OutputError naming the file that failed.
+/// OutputError naming the file that failed (cheval/common/output.h, WriteOutputs, has the contract).
 void WriteFilesAtomically(std::span<const FileToWrite> files);
 
 }  // namespace cheval::traj
