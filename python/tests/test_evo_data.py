@@ -67,7 +67,8 @@ class EvoDataTest(unittest.TestCase):
                 self.assertEqual(call(), expected)
 
     def test_published_numbers(self):
-        # docs/evaluation.md (and evo's own result files, tests/eval/evo_parity_test.py).
+        # docs/evaluation.md. Independent sources: KITTI 00 in evo's own result files
+        # (tests/eval/evo_parity_test.py); V1_02 has none, test_first_principles.py recomputes it in numpy.
         self.assertAlmostEqual(cheval.ape("KITTI_00_gt.txt", "KITTI_00_ORB.txt", align="se3")["stats"]["rmse"],
                                1.303450, places=6)
         v102 = cheval.ape("V102_groundtruth.csv", "V102.txt", align="se3")

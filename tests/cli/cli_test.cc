@@ -170,7 +170,10 @@ TEST_F(CliTest, VelocityFromNoisyPositions) {
   RunResult central = Cheval("velocity " + Path("m.txt") + " --method central -o " + Path("c.txt"));
   ASSERT_EQ(central.exit_code, 0) << central.err;
   const double cheb = VelocityRmse(Path("v.txt"), Path("t.txt")), diff = VelocityRmse(Path("c.txt"), Path("t.txt"));
-  EXPECT_LT(cheb, 0.2 * diff) << cheb << " vs central " << diff;
+  // Measured 0.23 mm/s against 123 mm/s for central differences (seeded 0.5 mm noise; the Chebyshev
+  // figure moves with the degrees the fit selects): ~2x the measured value, and 100x better.
+  EXPECT_LT(cheb, 0.0005) << cheb << " m/s";
+  EXPECT_LT(cheb, 0.01 * diff) << cheb << " vs central " << diff;
   const nlohmann::json j = nlohmann::json::parse(Slurp(Path("v.json")));
   for (const char* key : {"method", "windows", "degrees", "noise_sigma_m", "residual_rmse_m", "compression_ratio",
                           "seconds"}) {

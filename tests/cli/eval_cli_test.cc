@@ -160,7 +160,7 @@ TEST_F(EvalCliTest, RpeFramesAndDeltaUnits) {
 }
 
 // ASE with the reference's own velocity, and C-ASE from its positions (a smooth helix: the two
-// agree to well below a millimetre per second).
+// agree to ~1e-10 m/s).
 TEST_F(EvalCliTest, AseGivenAndChebyshevVelocity) {
   const std::string ref = Helix("ref.txt", 10), est = Helix("est.txt", 10, {0.3, 0, 0});
   const Output given = Run(fmt::format("ase {} {} --json {}", ref, est, File("g.json")));
@@ -175,7 +175,10 @@ TEST_F(EvalCliTest, AseGivenAndChebyshevVelocity) {
   ASSERT_EQ(cheb.code, 0) << cheb.stderr_text;
   const nlohmann::json c = nlohmann::json::parse(Read(File("c.json")));
   EXPECT_EQ(c["velocity_source"], "chebyshev");
-  EXPECT_LT(c["parts"]["velocity"]["rmse"].get<double>(), 1e-3);
+  // The C-ASE velocity is the derivative of the Chebyshev fit of exact (shortest round-trip) helix
+  // positions: only the fit's truncation and rounding remain, measured 2.2e-10 m/s; ~10x, since the
+  // degree the fit selects decides the figure.
+  EXPECT_LT(c["parts"]["velocity"]["rmse"].get<double>(), 2e-9);
   const Output full = Run(fmt::format("ase {} {} --align full --errors {}", ref, est, File("e.csv")));
   ASSERT_EQ(full.code, 0) << full.stderr_text;
   const std::string csv = Read(File("e.csv"));
@@ -244,7 +247,7 @@ TEST_F(EvalCliTest, SharedEvoFiles) {
   ASSERT_EQ(drift.code, 0) << drift.stderr_text;
   const nlohmann::json k = nlohmann::json::parse(Read(File("k.json")));
   EXPECT_EQ(k["drift"]["lengths"].size(), 8u);
-  EXPECT_GT(k["drift"]["segments"].get<int>(), 1000);
+  EXPECT_EQ(k["drift"]["segments"], 3283);  // docs/evaluation.md; the figures: kitti_drift_cli_test.cc
   EXPECT_NE(drift.stdout_text.find("KITTI drift over 100..800 m"), std::string::npos);
 }
 

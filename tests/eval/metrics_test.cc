@@ -97,7 +97,9 @@ TEST(ApeTest, ATrajectoryAgainstItselfIsZero) {
     // Positions cancel exactly; RᵀR of a rotation formed from a quaternion is I to a few ulps.
     const double rounding = RelationNeedsOrientation(r, false) ? 1e-15 : 0.0;
     for (double e : Ape(t, t, r)) ASSERT_LE(e, rounding) << ToString(r);
-    for (double e : Ape(t, t, r, AlignmentMethod::kSE3)) ASSERT_LT(e, 1e-9) << ToString(r);
+    // The SE(3) alignment of a trajectory onto itself is the identity to rounding: measured 4.1e-15 at
+    // most (kFull, metres and radians on a ~10 m flight); ~7x.
+    for (double e : Ape(t, t, r, AlignmentMethod::kSE3)) ASSERT_LT(e, 3e-14) << ToString(r);
   }
 }
 
@@ -316,9 +318,11 @@ TEST(AseTest, ChebyshevReferenceVelocity) {
   options.reference_velocity = ReferenceVelocitySource::kCentral;
   const EvaluationResult central = Evaluate(mocap.View(), truth.View(), options);
   EXPECT_EQ(central.velocity_source, "central");
-  // 0.5 mm noise at 100 Hz: central differences ~0.07 m/s, Chebyshev well below 0.01 m/s.
-  EXPECT_LT(cheb.velocity_stats.rmse, 0.01);
-  EXPECT_GT(central.velocity_stats.rmse, 3 * cheb.velocity_stats.rmse);
+  // 0.5 mm noise at 100 Hz: measured 0.061 m/s with central differences, 0.00055 m/s with Chebyshev
+  // (seeded noise; the figure moves with the degrees the fit selects): Chebyshev < 3x its figure, and
+  // at least 30x better than central differences (measured 111x).
+  EXPECT_LT(cheb.velocity_stats.rmse, 0.0015);
+  EXPECT_GT(central.velocity_stats.rmse, 30 * cheb.velocity_stats.rmse);
   // Position-only reference: position + velocity state error, labelled as such.
   const traj::Trajectory positions = MakeTrajectory(testing::PosesOf(mocap.View()), false, false);
   options.reference_velocity = ReferenceVelocitySource::kAuto;
@@ -348,11 +352,12 @@ TEST(ContinuousReferenceTest, EvaluatesTheReferenceAtTheEstimateStamps) {
   EXPECT_EQ(b.association.est.front(), 0);
   EXPECT_EQ(b.velocity_source, "chebyshev (continuous)");
   EXPECT_GT(a.position_stats.rmse, 0.005);
-  // Noise-free 100 Hz samples: the curve is accurate to ~1e-6 m and ~1e-4 m/s; slerp over 10 ms
-  // leaves ~1e-5 rad.
-  EXPECT_LT(b.position_stats.rmse, 1e-5);
-  EXPECT_LT(b.velocity_stats.rmse, 1e-3);
-  EXPECT_LT(b.rotation_stats.rmse, 1e-4);
+  // Noise-free 100 Hz samples: the curve is accurate to rounding and truncation, measured 4.5e-10 m and
+  // 3.3e-9 m/s (the degrees the fit selects decide it; bounds ~7-10x); the orientation is slerped
+  // between samples 10 ms apart, which leaves 8.9e-6 rad on this flight (bound ~3x).
+  EXPECT_LT(b.position_stats.rmse, 3e-9);
+  EXPECT_LT(b.velocity_stats.rmse, 3e-8);
+  EXPECT_LT(b.rotation_stats.rmse, 3e-5);
   continuous.reference_velocity = ReferenceVelocitySource::kGiven;
   EXPECT_THROW(Evaluate(ref.View(), est.View(), continuous), UsageError);
 }

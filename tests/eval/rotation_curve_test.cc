@@ -87,9 +87,11 @@ TEST(RotationCurve, NoiseFreeSpinIsExactAcrossManyChartsAndBlends) {
     const double t = static_cast<double>(queries[i] - kEpoch) * 1e-9;
     worst_angle = std::max(worst_angle, (SO3(orientations[i]).Inverse() * SO3(SpinRotation(t))).Log().norm());
   }
-  EXPECT_LT(worst_angle, 1e-7);
-  EXPECT_LT(RateRmse(queries, rates), 1e-5);
-  EXPECT_LT(curve.residual_rms_rad(), 1e-8);
+  // Measured 2.1e-9 rad between the samples, 6.1e-9 rad/s, residual 2.5e-10 rad: the charts' fits are
+  // exact but for truncation and rounding, which move with the degrees selected; bounds ~5x.
+  EXPECT_LT(worst_angle, 1e-8);
+  EXPECT_LT(RateRmse(queries, rates), 3e-8);
+  EXPECT_LT(curve.residual_rms_rad(), 1e-9);
 }
 
 // The blend across charts is differentiated exactly: the rate equals the derivative of the fitted

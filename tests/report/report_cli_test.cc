@@ -158,7 +158,10 @@ TEST_F(ReportCliTest, SeriesAreDecimatedWithTheirExtremes) {
   EXPECT_EQ(data["reference_velocity"]["given"]["t"], data["reference_velocity"]["chebyshev"]["t"]);
   double worst = 0;
   for (size_t i = 0; i < given.size(); ++i) worst = std::max(worst, std::abs(given[i] - chebyshev[i]));
-  EXPECT_LT(worst, 1e-3) << "m/s";
+  // Measured 1e-5 m/s: exactly one step of the plotted values' 6 significant digits at speeds of 1 to
+  // 10 m/s (the fits themselves agree to ~1e-9 m/s, tests/cli/eval_cli_test.cc). Two rounded values of
+  // speeds that close differ by at most one step, so 1.5 steps bounds it.
+  EXPECT_LE(worst, 1.5e-5) << "m/s";
 }
 
 // The fit diagnostics: every window with its degrees, the coefficient magnitudes of some windows
