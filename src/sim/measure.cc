@@ -76,8 +76,8 @@ traj::Trajectory Measure(const MotionModel& model, const MeasurementOptions& mea
     // Every stream draws for every nominal sample, so each effect is independent of the others.
     const bool dropped = dropout_random.Uniform() < dropout;
     const double offset_s = jitter_random.Normal() * jitter;
-    const Eigen::Vector3d n(noise_random.Normal(), noise_random.Normal(), noise_random.Normal());
-    const Eigen::Vector3d r(rotation_random.Normal(), rotation_random.Normal(), rotation_random.Normal());
+    const Eigen::Vector3d n = internal::NormalVector(noise_random);
+    const Eigen::Vector3d r = internal::NormalVector(rotation_random);
     const int64_t offset = stamp - start;
     while (gap < gaps.size() && offset >= gaps[gap].second) ++gap;
     const bool in_gap = gap < gaps.size() && offset >= gaps[gap].first;
@@ -130,7 +130,7 @@ traj::Trajectory AddPositionNoise(const traj::TrajectoryView& truth, double sigm
   std::vector<double> orientation(static_cast<size_t>(std::max(stride, 1)));
   for (Eigen::Index i = 0; i < truth.size(); ++i) {
     const Eigen::Vector3d noisy =
-        p.col(i) + sigma_m * Eigen::Vector3d(random.Normal(), random.Normal(), random.Normal());
+        p.col(i) + sigma_m * internal::NormalVector(random);
     if (channels.orientation == traj::OrientationKind::kQuaternion) {
       const Eigen::Vector4d q = truth.quaternions().col(i);
       std::copy(q.data(), q.data() + 4, orientation.begin());

@@ -41,7 +41,7 @@ traj::Trajectory SimulateEstimate(const MotionModel& model, const EstimatorSimOp
   const traj::Trajectory truth = SampleMotion(model, stamps);
   // One stream per estimate, after the streams of the measured copy.
   Random random(motion.seed, internal::kEstimate + 0x100 * options.stream);
-  auto normal3 = [&random] { return Eigen::Vector3d(random.Normal(), random.Normal(), random.Normal()); };
+  auto normal3 = [&random] { return internal::NormalVector(random); };
 
   traj::Trajectory estimate(traj::Channels{traj::OrientationKind::kQuaternion, true, false, true});
   estimate.Reserve(truth.size());

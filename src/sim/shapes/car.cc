@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "../internal/shape.h"
+#include "../internal/streams.h"
 #include "cheval/common/random.h"
 
 namespace cheval::sim::internal {
@@ -26,7 +27,7 @@ class Car final : public IntegratedShape<Car> {
     const std::array<std::array<double, 2>, 3> periods = {{{40.0, 60.0}, {20.0, 30.0}, {9.0, 14.0}}};
     for (int k = 0; k < 3; ++k) {
       m[k] = kTwoPi / r.Uniform(periods[k][0], periods[k][1]);
-      a[k] = r.Sign() * r.Uniform(0.05, 0.09) / m[k];  // heading amplitude from the yaw-rate amplitude
+      a[k] = SignedUniform(r, 0.05, 0.09) / m[k];  // heading amplitude from the yaw-rate amplitude
       th[k] = r.Uniform(0.0, kTwoPi);
     }
     grade = r.Uniform(0.02, 0.05);

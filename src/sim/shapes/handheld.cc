@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "../internal/shape.h"
+#include "../internal/streams.h"
 #include "cheval/common/random.h"
 
 namespace cheval::sim::internal {
@@ -25,10 +26,10 @@ class Handheld final : public IntegratedShape<Handheld> {
     phi = r.Uniform(0.0, kTwoPi);
     psi0 = r.Uniform(-kPi, kPi);
     m1 = kTwoPi / r.Uniform(20.0, 40.0);
-    a1 = r.Sign() * r.Uniform(0.15, 0.25) / m1;
+    a1 = SignedUniform(r, 0.15, 0.25) / m1;
     t1 = r.Uniform(0.0, kTwoPi);
     m2 = kTwoPi / r.Uniform(8.0, 15.0);
-    a2 = r.Sign() * r.Uniform(0.1, 0.2) / m2;
+    a2 = SignedUniform(r, 0.1, 0.2) / m2;
     t2 = r.Uniform(0.0, kTwoPi);
     ws = kTwoPi * r.Uniform(1.5, 2.0);
     bounce = r.Uniform(0.02, 0.04);

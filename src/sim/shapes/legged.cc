@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "../internal/shape.h"
+#include "../internal/streams.h"
 #include "cheval/common/random.h"
 
 namespace cheval::sim::internal {
@@ -22,7 +23,7 @@ class Legged final : public IntegratedShape<Legged> {
     phi = r.Uniform(0.0, kTwoPi);
     psi0 = r.Uniform(-kPi, kPi);
     mu = kTwoPi / r.Uniform(8.0, 14.0);
-    alpha = r.Sign() * r.Uniform(0.1, 0.2) / mu;
+    alpha = SignedUniform(r, 0.1, 0.2) / mu;
     theta = r.Uniform(0.0, kTwoPi);
     wg = kTwoPi * r.Uniform(2.0, 3.0);
     az = r.Uniform(0.010, 0.015);
