@@ -1,8 +1,9 @@
 #pragma once
 /// \file
-/// The random streams of the simulator and its sequenced draws: every use draws from its own stream of the seed
-/// (cheval::Random(seed, stream)), so e.g. changing the noise does not move the dropouts. The values
-/// are part of the outputs: changing one changes every file made with that stream. Internal to src/sim.
+/// The random streams of the simulator and its sequenced draws: every use draws from its own stream
+/// of the seed (cheval::Random(seed, stream)), so e.g. changing the noise does not move the dropouts.
+/// The values are part of the outputs: changing one changes every file made with that stream.
+/// Internal to src/sim.
 
 #include <Eigen/Core>
 #include <cstdint>
