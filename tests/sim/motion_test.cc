@@ -354,62 +354,76 @@ TEST(Measure, GapsAppearWithTheAskedCountAndLength) {
 
 struct BadMeasurement {
   MeasurementOptions options;
+  std::string field;
   std::string message;
 };
 
-TEST(Measure, RejectsBadOptionsNamingTheFlag) {
+// Bad values are OptionErrors naming the struct and field (the CLI and Python spell the field their way).
+TEST(Measure, RejectsBadOptionsNamingTheField) {
   const MotionModel model = Model(MotionKind::kLegged);  // 10 s at 200 Hz
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const std::vector<BadMeasurement> cases = {
-      {{-0.1, 0, 0, 0, 0}, "--noise must be a non-negative number of metres, got -0.1"},
-      {{nan, 0, 0, 0, 0}, "--noise must be a non-negative number of metres, got nan"},
-      {{0, -1, 0, 0, 0}, "--jitter must be a non-negative number of seconds below --duration (10 s), got -1"},
-      {{0, 10, 0, 0, 0}, "--jitter must be a non-negative number of seconds below --duration (10 s), got 10"},
-      {{0, 0, 1, 0, 0}, "--dropout must be a probability in [0, 1), got 1"},
-      {{0, 0, -0.5, 0, 0}, "--dropout must be a probability in [0, 1), got -0.5"},
-      {{0, 0, 0, -2, 1}, "--gap-count must be non-negative, got -2"},
-      {{0, 0, 0, 2, 0}, "--gap-seconds must be a positive number of seconds when --gap-count is given, got 0"},
-      {{0, 0, 0, 0, 1.5}, "--gap-seconds 1.5 needs --gap-count (the number of gaps)"},
+      {{-0.1, 0, 0, 0, 0}, "noise_m", "must be a non-negative number of metres, got -0.1"},
+      {{nan, 0, 0, 0, 0}, "noise_m", "must be a non-negative number of metres, got nan"},
+      {{0, -1, 0, 0, 0}, "jitter_s", "must be a non-negative number of seconds, got -1"},
+      {{0, 10, 0, 0, 0}, "jitter_s", "must be below the duration (10 s), got 10"},
+      {{0, 0, 1, 0, 0}, "dropout_probability", "must be a probability in [0, 1), got 1"},
+      {{0, 0, -0.5, 0, 0}, "dropout_probability", "must be a probability in [0, 1), got -0.5"},
+      {{0, 0, 0, -2, 1}, "gap_count", "must be non-negative, got -2"},
+      {{0, 0, 0, 2, 0}, "gap_s", "must be a positive number of seconds when there are gaps, got 0"},
+      {{0, 0, 0, 0, 1.5}, "gap_s", "must be 0 when the gap count is 0, got 1.5"},
       {{0, 0, 0, 4, 2.5},
-       "--gap-count 4 x --gap-seconds 2.5 does not fit in --duration 10 s: each gap needs a slot of duration / "
-       "count longer than the gap plus two sample periods"},
-      {{0, 0, 0.9999999, 1, 9.98}, "--dropout 0.9999999 and the gaps leave 0 of 2001 samples; at least 2 are needed"},
+       "gap_s",
+       "must fit 4 gaps in the duration (10 s): each needs a slot of duration / gap count longer than the gap plus "
+       "two sample periods, got 2.5"},
+      {{0, 0, 0.9999999, 1, 9.98},
+       "dropout_probability",
+       "must leave, with the gaps, at least 2 of the 2001 samples (it left 0), got 0.9999999"},
+      {{0, 0, 0, 0, 0, -0.1}, "rotation_noise_rad", "must be a non-negative number of radians, got -0.1"},
   };
   for (const BadMeasurement& c : cases) {
     try {
       Measure(model, c.options);
       ADD_FAILURE() << "no error for: " << c.message;
-    } catch (const UsageError& e) {
-      EXPECT_EQ(std::string(e.what()), c.message);
+    } catch (const OptionError& e) {
+      EXPECT_EQ(e.options(), "MeasurementOptions");
+      EXPECT_EQ(e.field(), c.field);
+      EXPECT_EQ(e.rule(), c.message);
+      EXPECT_EQ(std::string(e.what()), "MeasurementOptions::" + c.field + " " + c.message);
     }
   }
 }
 
-TEST(MotionModel, RejectsBadOptionsNamingTheFlag) {
+TEST(MotionModel, RejectsBadOptionsNamingTheField) {
   auto message = [](MotionOptions options) {
     try {
       MotionModel model(options);
-    } catch (const UsageError& e) {
+    } catch (const OptionError& e) {
       return std::string(e.what());
     }
     return std::string("no error");
   };
   MotionOptions o;
   o.rate_hz = -1.0;
-  EXPECT_EQ(message(o), "--rate must be a positive number of Hz, got -1");
+  EXPECT_EQ(message(o), "MotionOptions::rate_hz must be a positive number of Hz, got -1");
   o.rate_hz = std::numeric_limits<double>::infinity();
-  EXPECT_EQ(message(o), "--rate must be a positive number of Hz, got inf");
+  EXPECT_EQ(message(o), "MotionOptions::rate_hz must be a positive number of Hz, got inf");
   o = {};
   o.duration_s = 0.0;
-  EXPECT_EQ(message(o), "--duration must be a positive number of seconds, got 0");
+  EXPECT_EQ(message(o), "MotionOptions::duration_s must be a positive number of seconds, got 0");
   o.duration_s = 2e6;
-  EXPECT_EQ(message(o), "--duration must be at most 1e6 s, got 2000000");
+  EXPECT_EQ(message(o), "MotionOptions::duration_s must be at most 1e6 s, got 2000000");
   o.duration_s = 1e6;
   o.rate_hz = 1000.0;
-  EXPECT_EQ(message(o), "--duration x --rate asks for more than 1e8 samples");
+  EXPECT_EQ(message(o), "MotionOptions::rate_hz must give at most 1e8 samples over the duration (1000000 s), got 1000 Hz");
   o = {};
   o.start_stamp_ns = 5'000'000'000'000'000'000;
-  EXPECT_EQ(message(o), "start stamp must be within ±4e18 ns, got 5000000000000000000");
+  EXPECT_EQ(message(o), "MotionOptions::start_stamp_ns must be within ±4e18 ns, got 5000000000000000000");
+  o = {};
+  o.kind = static_cast<MotionKind>(7);
+  EXPECT_EQ(message(o), "MotionOptions::kind must be one of car, legged, drone, handheld, got 7");
+  // Validate() alone checks the fields that are set; unset duration and rate are the kind's defaults.
+  EXPECT_NO_THROW(MotionOptions{}.Validate());
 }
 
 TEST(AddPositionNoise, KeepsStampsAndOrientationsAndAddsTheAskedSigma) {
@@ -483,24 +497,34 @@ TEST(SimulateEstimate, DeterministicPerSeedAndStream) {
   EXPECT_NE(a.raw_positions(), b.raw_positions());
 }
 
-TEST(SimulateEstimate, BadValuesNameTheOption) {
+TEST(SimulateEstimate, BadValuesNameTheField) {
   const MotionModel model = Model(MotionKind::kDrone);
   auto message = [&model](auto change) {
     EstimatorSimOptions options;
     change(options);
     try {
       SimulateEstimate(model, options);
-    } catch (const UsageError& e) {
+    } catch (const OptionError& e) {
       return std::string(e.what());
     }
     return std::string("no error");
   };
-  EXPECT_EQ(message([](EstimatorSimOptions& o) { o.rate_hz = 0; }), "--estimate-rate must be a positive number of Hz, got 0");
+  EXPECT_EQ(message([](EstimatorSimOptions& o) { o.rate_hz = 0; }),
+            "EstimatorSimOptions::rate_hz must be a positive number of Hz, got 0");
   EXPECT_EQ(message([](EstimatorSimOptions& o) { o.velocity_random_walk = -1; }),
-            "--estimate-drift must be a non-negative finite number, got -1");
+            "EstimatorSimOptions::velocity_random_walk must be a non-negative finite number, got -1");
   EXPECT_EQ(message([](EstimatorSimOptions& o) { o.rotation_random_walk_rad = std::nan(""); }),
-            "--estimate-rotation-drift must be a non-negative finite number, got nan");
-  EXPECT_EQ(message([](EstimatorSimOptions& o) { o.delay_s = 60; }), "the estimate's delay must be in [0, 60) s, got 60");
+            "EstimatorSimOptions::rotation_random_walk_rad must be a non-negative finite number, got nan");
+  EXPECT_EQ(message([](EstimatorSimOptions& o) { o.position_noise_m = -0.5; }),
+            "EstimatorSimOptions::position_noise_m must be a non-negative finite number, got -0.5");
+  EXPECT_EQ(message([](EstimatorSimOptions& o) { o.velocity_noise_mps = std::nan(""); }),
+            "EstimatorSimOptions::velocity_noise_mps must be a non-negative finite number, got nan");
+  EXPECT_EQ(message([](EstimatorSimOptions& o) { o.delay_s = -1; }),
+            "EstimatorSimOptions::delay_s must be a non-negative number of seconds, got -1");
+  EXPECT_EQ(message([](EstimatorSimOptions& o) { o.delay_s = 60; }),
+            "EstimatorSimOptions::delay_s must be below the duration (60 s), got 60");
+  EXPECT_EQ(message([](EstimatorSimOptions& o) { o.rate_hz = 0.01; }),
+            "EstimatorSimOptions::rate_hz must give 2 to 1e8 poses over 60 s (it gives 1), got 0.01");
 }
 
 }  // namespace

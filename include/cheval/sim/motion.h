@@ -53,34 +53,45 @@ struct MotionDefaults {
 /// 30 s at 100 Hz.
 MotionDefaults DefaultsFor(MotionKind kind);
 
-/// What to generate. Validated when a MotionModel is built (UsageError naming the CLI option).
+/// What to generate. Validated when a MotionModel is built (with the kind's defaults filled in).
 struct MotionOptions {
-  MotionKind kind = MotionKind::kDrone;                ///< --kind
-  std::optional<double> duration_s;                    ///< --duration, > 0 and <= 1e6 s; nullopt: the kind's default
-  std::optional<double> rate_hz;                       ///< --rate, > 0 Hz; nullopt: the kind's default
+  MotionKind kind = MotionKind::kDrone;                ///< one of the MotionKind values
+  std::optional<double> duration_s;                    ///< > 0 and <= 1e6 s; nullopt: the kind's default
+  std::optional<double> rate_hz;                       ///< > 0 Hz; nullopt: the kind's default
   int64_t start_stamp_ns = 1'403'636'580'000'000'000;  ///< stamp of t = 0 (EuRoC-like epoch), |.| <= 4e18
-  uint64_t seed = 1;  ///< --seed: draws the shape's random parameters and every measurement effect
+  uint64_t seed = 1;  ///< draws the shape's random parameters and every measurement effect
+
+  /// Throws OptionError naming the first bad field: a kind outside MotionKind; a duration that is
+  /// not positive and finite or above 1e6 s; a rate that is not positive and finite; a duration ×
+  /// rate grid of more than 1e8 samples (when both are set); a start stamp outside ±4e18 ns.
+  void Validate() const;
 };
 
 /// How the measured copy differs from the truth (Measure). Every effect has its own random stream
 /// derived from MotionOptions::seed, so e.g. changing the noise does not move the dropouts.
 struct MeasurementOptions {
-  double noise_m = 0.0;  ///< --noise: σ of N(0, σ²) added to each position coordinate, metres, >= 0
-  /// --jitter: σ in seconds of the Gaussian offset added to each nominal stamp (>= 0, < duration).
+  double noise_m = 0.0;  ///< σ of N(0, σ²) added to each position coordinate, metres, >= 0
+  /// σ in seconds of the Gaussian offset added to each nominal stamp (>= 0, < duration).
   /// The jittered stamps are rounded to the nanosecond, sorted, and each one not above its
   /// predecessor is moved to predecessor + 1 ns, so stamps strictly increase; positions are the truth
   /// at the final stamps, so the order change (only when σ is a sizeable part of the period) costs
   /// no exactness.
   double jitter_s = 0.0;
-  double dropout_probability = 0.0;  ///< --dropout: each nominal sample is dropped with this probability, [0, 1)
-  /// --gap-count: number of longer gaps. The duration is cut into gap_count equal slots and one gap
+  double dropout_probability = 0.0;  ///< each nominal sample is dropped with this probability, [0, 1)
+  /// Number of longer gaps. The duration is cut into gap_count equal slots and one gap
   /// of gap_s is placed uniformly at random inside each slot, one nominal period away from the slot
   /// ends; nominal samples with stamp offset in [start, start + gap_s) are removed. >= 0.
   int gap_count = 0;
-  double gap_s = 0.0;  ///< --gap-seconds: length of each gap, > 0 exactly when gap_count > 0
-  /// --rotation-noise: σ in radians of the body-frame perturbation of each measured orientation,
+  double gap_s = 0.0;  ///< length of each gap, > 0 exactly when gap_count > 0 (else 0)
+  /// σ in radians of the body-frame perturbation of each measured orientation,
   /// R_measured = R·Exp(n) with n ~ N(0, σ²I₃) (>= 0; motion capture: ~0.002-0.01 rad).
   double rotation_noise_rad = 0.0;
+
+  /// Throws OptionError naming the first bad field: a negative or non-finite noise_m, jitter_s or
+  /// rotation_noise_rad; a dropout_probability outside [0, 1); a negative gap_count; a gap_s that is
+  /// not positive and finite when gap_count > 0, or not 0 when it is 0. (The rules that need the
+  /// model's duration are Measure's.)
+  void Validate() const;
 };
 
 /// The exact state at one time.
@@ -96,10 +107,9 @@ struct MotionState {
 /// immutable state); safe to evaluate from several threads.
 class MotionModel {
  public:
-  /// Draws the kind's parameters from `options.seed` and fills in the kind's default duration and
-  /// rate where they are unset. Throws UsageError naming the option (e.g. "--rate must be a positive
-  /// number of Hz, got -1") for a non-positive or non-finite duration or rate, a duration above 1e6 s,
-  /// a grid of more than 1e8 samples, or a start stamp outside ±4e18 ns.
+  /// Fills in the kind's default duration and rate where they are unset, validates the result
+  /// (MotionOptions::Validate: OptionError, e.g. "MotionOptions::rate_hz must be a positive number of
+  /// Hz, got -1") and draws the kind's parameters from `options.seed`.
   explicit MotionModel(const MotionOptions& options);
 
   /// The options with the defaults filled in: duration_s and rate_hz always hold a value.
@@ -130,43 +140,49 @@ traj::Trajectory SampleMotion(const MotionModel& model, std::span<const int64_t>
 
 /// The truth on the model's nominal grid: SampleMotion(model, model.NominalStamps()).
 traj::Trajectory GenerateMotion(const MotionModel& model);
-/// GenerateMotion(MotionModel(options)). Throws UsageError as MotionModel does.
+/// GenerateMotion(MotionModel(options)). Throws OptionError as MotionModel does.
 traj::Trajectory GenerateMotion(const MotionOptions& options);
 
 /// The measured copy of `model` (positions and quaternions; no velocity channels): nominal grid
 /// samples are removed by the gaps and dropouts, the survivors' stamps jittered (see
 /// MeasurementOptions::jitter_s), and each position is the exact truth at its final stamp plus
 /// N(0, noise_m²) per coordinate; orientations are the truth perturbed by rotation_noise_rad.
-/// Deterministic in the model's seed. Throws UsageError naming the option for a negative or
-/// non-finite noise or jitter, a jitter not below the duration, a dropout outside [0, 1), a negative
-/// gap count, gap seconds that are not positive exactly when the gap count is, gaps that do not fit
-/// in the duration, or when fewer than 2 samples would remain.
+/// Deterministic in the model's seed. Throws OptionError naming the field: what
+/// MeasurementOptions::Validate rejects, a jitter_s not below the duration, gaps that do not fit in
+/// the duration (gap_s + 2 / rate must be below duration / gap_count), or dropout_probability when
+/// fewer than 2 samples would remain.
 traj::Trajectory Measure(const MotionModel& model, const MeasurementOptions& measurement);
 
-/// How a simulated state estimator (a visual-inertial odometry, say) errs: what `cheval sim motion
-/// --estimate` writes, so that evaluation (APE, RPE, ASE) and reports can be shown on data cheval
+/// How a simulated state estimator (a visual-inertial odometry, say) errs: what the CLI's simulated
+/// estimates are (docs/sim.md), so that evaluation (APE, RPE, ASE) and reports can be shown on data cheval
 /// makes itself. The errors drift as an odometry's do: the velocity error b(t) is a random walk,
 /// the position error is its integral plus white noise (so position drift and velocity error are
 /// consistent, as in a filter), and the orientation error is a random walk on SO(3).
 struct EstimatorSimOptions {
-  double rate_hz = 20.0;                          ///< --estimate-rate: output rate, > 0 Hz
-  double velocity_random_walk = 0.002;            ///< --estimate-drift: σ of b's random walk, m/s per √s, >= 0
-  double position_noise_m = 0.002;                ///< white noise on each position coordinate, m, >= 0
-  double velocity_noise_mps = 0.005;              ///< white noise on each velocity coordinate, m/s, >= 0
-  double rotation_random_walk_rad = 0.002;        ///< --estimate-rotation-drift: rad per √s, >= 0
-  double delay_s = 0.0;                           ///< stamps start this long after the truth's start, [0, duration)
-  uint64_t stream = 0;                            ///< distinguishes several estimates of one model and seed
+  double rate_hz = 20.0;                    ///< output rate, > 0 Hz
+  double velocity_random_walk = 0.002;      ///< σ of b's random walk, m/s per √s, >= 0
+  double position_noise_m = 0.002;          ///< white noise on each position coordinate, m, >= 0
+  double velocity_noise_mps = 0.005;        ///< white noise on each velocity coordinate, m/s, >= 0
+  double rotation_random_walk_rad = 0.002;  ///< σ of the orientation error's random walk, rad per √s, >= 0
+  double delay_s = 0.0;                     ///< stamps start this long after the truth's start, [0, duration)
+  uint64_t stream = 0;                      ///< distinguishes several estimates of one model and seed
+
+  /// Throws OptionError naming the first bad field: a rate_hz that is not positive and finite, a
+  /// negative or non-finite σ, or a negative or non-finite delay_s. (The rules that need the model's
+  /// duration are SimulateEstimate's.)
+  void Validate() const;
 };
 
 /// A simulated estimator's output for `model`: TUM + velocity (positions, R_world_body quaternions,
 /// world-frame velocities) at options.rate_hz from the model's start (+ delay_s) to its duration,
 /// with the errors of EstimatorSimOptions, starting from zero error. Deterministic in the model's
-/// seed and options.stream. Throws UsageError naming the CLI option for a bad value.
+/// seed and options.stream. Throws OptionError naming the field: what EstimatorSimOptions::Validate
+/// rejects, a delay_s not below the duration, or a rate_hz giving fewer than 2 or more than 1e8 poses.
 traj::Trajectory SimulateEstimate(const MotionModel& model, const EstimatorSimOptions& options);
 
 /// A copy of any `truth` without velocity channels and with N(0, sigma_m²) noise on every position
 /// coordinate (metres), drawn from a generator seeded with `seed`; stamps and orientations are kept.
-/// Throws UsageError ("--noise ...") unless sigma_m is finite and >= 0.
+/// Throws UsageError unless sigma_m is finite and >= 0.
 traj::Trajectory AddPositionNoise(const traj::TrajectoryView& truth, double sigma_m, uint64_t seed);
 
 }  // namespace cheval::sim
