@@ -6,10 +6,10 @@
 #include <array>
 #include <cmath>
 #include <numbers>
-#include <random>
 
 #include "cheval/common/error.h"
 #include "cheval/common/options.h"
+#include "cheval/common/random.h"
 #include "cheval/lie/so3.h"
 
 namespace cheval::sim {
@@ -77,33 +77,22 @@ Reference MakeReference(QuadrotorScenario scenario) {
   return r;
 }
 
-// Gaussian numbers from std::mt19937_64 through our own Box–Muller transform (the standard's
-// distributions differ between libraries; this does not).
-class Gaussian {
- public:
-  Gaussian(uint64_t seed, uint64_t stream) : engine_(seed * 0x9E3779B97F4A7C15ULL + stream * 0xD1B54A32D192ED03ULL + 1) {}
-  double Uniform() { return (static_cast<double>(engine_() >> 11) + 0.5) * 0x1.0p-53; }
-  double Normal() {
-    if (spare_) {
-      spare_ = false;
-      return cached_;
-    }
-    const double r = std::sqrt(-2.0 * std::log(Uniform())), a = 2 * kPi * Uniform();
-    cached_ = r * std::sin(a);
-    spare_ = true;
-    return r * std::cos(a);
-  }
-  Eigen::Vector3d Normal3() {
-    const double a = Normal(), b = Normal(), c = Normal();
-    return {a, b, c};
-  }
-  uint64_t Bits() { return engine_(); }
+// The simulator's streams of the project's generator (common/random.h). Their engines are seeded
+// from (seed, stream) by this file's own mix and Normal() takes midpoint uniforms, as the data
+// folders of earlier versions were made, so a seed still gives the same flight.
+Random SimulatorRandom(uint64_t seed, uint64_t stream) {
+  return Random::FromEngineSeed(seed * 0x9E3779B97F4A7C15ULL + stream * 0xD1B54A32D192ED03ULL + 1,
+                                Random::BoxMullerInput::kMidpoint);
+}
 
- private:
-  std::mt19937_64 engine_;
-  bool spare_ = false;
-  double cached_ = 0;
-};
+// (k + ½)·2⁻⁵³ from the top 53 bits k of the next output: uniform in (0, 1).
+double MidpointUniform(Random& random) { return (static_cast<double>(random() >> 11) + 0.5) * 0x1.0p-53; }
+
+// Three normals drawn in the order x, y, z.
+Eigen::Vector3d Normal3(Random& random) {
+  const double a = random.Normal(), b = random.Normal(), c = random.Normal();
+  return {a, b, c};
+}
 
 // Simulation state: p, q (x y z w), v, ω, Ω.
 struct State {
@@ -244,12 +233,12 @@ class Simulator {
 estim::QuadrotorTruth ToTruth(const State& s, double t) { return {t, s.p, s.q, s.v, s.w, s.rotor}; }
 
 // Landmarks on the faces of the room [-10, 10]² x [0, 6], uniform in area.
-std::vector<Eigen::Vector3d> MakeLandmarks(int count, Gaussian& random) {
+std::vector<Eigen::Vector3d> MakeLandmarks(int count, Random& random) {
   std::vector<Eigen::Vector3d> points;
   const double wall = 20.0 * 6.0, floor = 20.0 * 20.0, total = 4 * wall + 2 * floor;
   for (int i = 0; i < count; ++i) {
-    double pick = random.Uniform() * total;
-    const double a = random.Uniform() * 20.0 - 10.0, b = random.Uniform();
+    double pick = MidpointUniform(random) * total;
+    const double a = MidpointUniform(random) * 20.0 - 10.0, b = MidpointUniform(random);
     if (pick < 4 * wall) {
       const int face = std::min(3, static_cast<int>(pick / wall));
       const double h = b * 6.0;
@@ -322,8 +311,8 @@ estim::QuadrotorData SimulateQuadrotor(const estim::Vehicle& vehicle, const Quad
   estim::ValidateVehicle(vehicle, "<vehicle>");
   estim::QuadrotorData data;
   data.vehicle = vehicle;
-  Gaussian landmark_random(options.seed, 1), pixel_random(options.seed, 2), vo_random(options.seed, 3),
-      pick_random(options.seed, 4);
+  Random landmark_random = SimulatorRandom(options.seed, 1), pixel_random = SimulatorRandom(options.seed, 2),
+         vo_random = SimulatorRandom(options.seed, 3), pick_random = SimulatorRandom(options.seed, 4);
   data.landmarks = MakeLandmarks(options.landmarks, landmark_random);
 
   const Simulator sim(vehicle.quadrotor, MakeReference(options.scenario));
@@ -354,23 +343,25 @@ estim::QuadrotorData SimulateQuadrotor(const estim::Vehicle& vehicle, const Quad
     // A front end tracks a random subset of at most max_features_per_frame (partial Fisher–Yates).
     const int keep = std::min<int>(options.max_features_per_frame, static_cast<int>(visible.size()));
     for (int i = 0; i < keep; ++i) {
-      const int j = i + static_cast<int>(pick_random.Bits() % static_cast<uint64_t>(visible.size() - i));
+      const int j = i + static_cast<int>(pick_random() % static_cast<uint64_t>(visible.size() - i));
       std::swap(visible[i], visible[j]);
       std::swap(uvs[i], uvs[j]);
     }
     std::vector<estim::PixelObservation> seen;
     for (int i = 0; i < keep; ++i) {
-      const Eigen::Vector2d noise(pixel_random.Normal(), pixel_random.Normal());
+      // y before x: the order GCC evaluated the two arguments of the earlier two-argument form in.
+      const double noise_y = pixel_random.Normal(), noise_x = pixel_random.Normal();
+      const Eigen::Vector2d noise(noise_x, noise_y);
       seen.push_back({t, visible[i], uvs[i] + camera.pixel_noise_px * noise});
     }
     std::sort(seen.begin(), seen.end(), [](const auto& a, const auto& b) { return a.landmark < b.landmark; });
     data.pixels.insert(data.pixels.end(), seen.begin(), seen.end());
     if (next_frame > 0) {
-      drift_p += options.vo_position_drift_m_per_sqrt_s * std::sqrt(frame_dt) * vo_random.Normal3();
-      drift_r += options.vo_rotation_drift_rad_per_sqrt_s * std::sqrt(frame_dt) * vo_random.Normal3();
+      drift_p += options.vo_position_drift_m_per_sqrt_s * std::sqrt(frame_dt) * Normal3(vo_random);
+      drift_r += options.vo_rotation_drift_rad_per_sqrt_s * std::sqrt(frame_dt) * Normal3(vo_random);
     }
-    const Eigen::Vector3d np = options.vo_position_noise_m * vo_random.Normal3();
-    const Eigen::Vector3d nr = options.vo_rotation_noise_rad * vo_random.Normal3();
+    const Eigen::Vector3d np = options.vo_position_noise_m * Normal3(vo_random);
+    const Eigen::Vector3d nr = options.vo_rotation_noise_rad * Normal3(vo_random);
     const Eigen::Quaterniond q_vo = lie::SO3d(at.q).Plus(drift_r + nr).quaternion();
     data.initial.push_back({t, at.p + drift_p + np, q_vo});
   };
