@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -10,16 +12,12 @@
 #include <system_error>
 
 #include "cheval/common/error.h"
-#include "cheval/traj/io.h"
+#include "cheval/common/output.h"
 
 namespace cheval::estim {
 namespace {
 
 std::string Num(double x) { return fmt::format("{:.17g}", x); }
-
-void WriteText(const std::filesystem::path& path, const std::string& text) {
-  traj::WriteFileAtomically(path.string(), text);
-}
 
 // Rows of a CSV file with a header line; every row must have `columns` numbers.
 std::vector<std::vector<double>> ReadCsv(const std::filesystem::path& path, size_t columns) {
@@ -69,30 +67,50 @@ std::string QuadrotorStatesCsv(const std::vector<QuadrotorTruth>& states) {
   return text;
 }
 
-void WriteQuadrotorData(const QuadrotorData& data, const std::string& folder) {
-  const std::filesystem::path dir(folder);
+namespace {
+
+// The files of a data folder, in the order they are written.
+constexpr std::array<std::string_view, 5> kDataFiles = {"vehicle.json", "landmarks.csv", "measurements.csv",
+                                                        "initial.csv", "truth.csv"};
+
+// True when `folder` exists and holds nothing but files named like those of a data folder (so it is
+// one, from an earlier run): such a folder is replaced whole; any other non-empty folder is refused.
+bool IsDataFolder(const std::string& folder) {
   std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw OutputError(fmt::format("{}: error: cannot create folder: {}", folder, ec.message()));
-  WriteText(dir / "vehicle.json", VehicleToJson(data.vehicle));
+  if (!std::filesystem::is_directory(folder, ec)) return false;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (!entry.is_regular_file(ec) || std::find(kDataFiles.begin(), kDataFiles.end(), name) == kDataFiles.end()) {
+      return false;
+    }
+  }
+  return !ec;
+}
+
+}  // namespace
+
+void WriteQuadrotorData(const QuadrotorData& data, const std::string& folder) {
+  StagedFolder staged(folder);
+  staged.Write(std::string(kDataFiles[0]), VehicleToJson(data.vehicle));
   std::string text = "id,x,y,z\n";
   for (size_t i = 0; i < data.landmarks.size(); ++i) {
     const Eigen::Vector3d& x = data.landmarks[i];
     text += fmt::format("{},{},{},{}\n", i, Num(x.x()), Num(x.y()), Num(x.z()));
   }
-  WriteText(dir / "landmarks.csv", text);
+  staged.Write(std::string(kDataFiles[1]), text);
   text = "t,landmark,u,v\n";
   for (const PixelObservation& m : data.pixels) {
     text += fmt::format("{},{},{},{}\n", Num(m.t), m.landmark, Num(m.uv.x()), Num(m.uv.y()));
   }
-  WriteText(dir / "measurements.csv", text);
+  staged.Write(std::string(kDataFiles[2]), text);
   text = "t,px,py,pz,qw,qx,qy,qz\n";
   for (const PoseSample& s : data.initial) {
     text += fmt::format("{},{},{},{},{},{},{},{}\n", Num(s.t), Num(s.p.x()), Num(s.p.y()), Num(s.p.z()), Num(s.q.w()),
                         Num(s.q.x()), Num(s.q.y()), Num(s.q.z()));
   }
-  WriteText(dir / "initial.csv", text);
-  if (!data.truth.empty()) WriteText(dir / "truth.csv", QuadrotorStatesCsv(data.truth));
+  staged.Write(std::string(kDataFiles[3]), text);
+  if (!data.truth.empty()) staged.Write(std::string(kDataFiles[4]), QuadrotorStatesCsv(data.truth));
+  staged.Publish(IsDataFolder(folder) ? FolderExisting::kReplace : FolderExisting::kRefuse);
 }
 
 QuadrotorData ReadQuadrotorData(const std::string& folder) {

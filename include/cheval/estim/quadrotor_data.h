@@ -43,8 +43,11 @@ struct QuadrotorData {
 std::string QuadrotorStatesCsv(const std::vector<QuadrotorTruth>& states);
 
 /// Writes a data folder (docs/estimator.md): vehicle.json, landmarks.csv, measurements.csv,
-/// initial.csv and, when `data.truth` is not empty, truth.csv. Creates the folder. OutputError
-/// when the folder or a file cannot be written.
+/// initial.csv and, when `data.truth` is not empty, truth.csv. Written whole or not at all
+/// (common/output.h, StagedFolder): the files go to a staging folder beside `folder` that is renamed
+/// into place. An existing folder that holds only data-folder files (an earlier run) is replaced
+/// whole; any other non-empty existing folder is refused, so two runs are never mixed and unrelated
+/// files are never deleted. OutputError when the folder cannot be written or is refused.
 void WriteQuadrotorData(const QuadrotorData& data, const std::string& folder);
 
 /// Reads a data folder. truth.csv is optional; every other file is required. InputError naming
