@@ -28,7 +28,7 @@ const std::string kVehicle = std::string(CHEVAL_SOURCE_DIR) + "/data/vehicles/fl
 
 TEST(QuadrotorModel, ShippedVehicleHoversAtTheDocumentedSpeed) {
   const estim::Vehicle v = estim::ReadVehicle(kVehicle);
-  // ESTIMATOR.md: sqrt(m g / 4 k_F) ≈ 1133 rad/s for the FlightGoggles vehicle.
+  // docs/estimator.md: sqrt(m g / 4 k_F) ≈ 1133 rad/s for the FlightGoggles vehicle.
   EXPECT_NEAR(v.quadrotor.HoverRotorSpeed(), std::sqrt(1.0 * 9.81 / (4 * 1.91e-6)), 1e-9);
   EXPECT_NEAR(v.quadrotor.HoverRotorSpeed(), 1133.1, 0.1);
   const estim::QuadrotorModel model{v.quadrotor};
@@ -39,7 +39,7 @@ TEST(QuadrotorModel, ShippedVehicleHoversAtTheDocumentedSpeed) {
   for (int i = 0; i < 9; ++i) EXPECT_NEAR(x_dot[i], 0.0, 1e-12) << i;
 }
 
-// Motor layout of ESTIMATOR.md: speeding up the two left motors (0, 1; y = +a) rolls right-side
+// Motor layout of docs/estimator.md: speeding up the two left motors (0, 1; y = +a) rolls right-side
 // down (τ_x > 0); the front ones (0, 3; x = +a) pitch nose up (τ_y < 0); the +1-spin motors (1, 3)
 // yaw positive.
 TEST(QuadrotorModel, TorquesFollowTheMotorLayout) {

@@ -34,7 +34,6 @@
 #include <Eigen/Geometry>
 
 #include "cheval/cheb/chebyshev.h"
-#include "cheval/cheb/quadrature.h"
 #include "cheval/common/error.h"
 #include "cheval/estim/internal/block_cost.h"
 #include "cheval/estim/internal/collocation_cost.h"
@@ -43,6 +42,7 @@
 #include "cheval/estim/internal/derivative_measurement_cost.h"
 #include "cheval/estim/internal/measurement_cost.h"
 #include "cheval/estim/internal/segment.h"
+#include "cheval/estim/internal/smoothness_rows.h"
 #include "cheval/estim/manifold.h"
 #include "cheval/lie/so3.h"
 
@@ -375,22 +375,7 @@ class PseudoSpectralProblem {
   /// The jump rows of the order-m prior with σ at the breakpoint between segments s and s + 1
   /// (order − 1 rows over the global nodes s·N .. (s + 2)·N, in that order); empty for m = 1.
   Eigen::MatrixXd SmoothnessJumpMatrix(int order, int s, double sigma) const {
-    const int N = degree_;
-    const double h_unit = 1.0 - basis_.points()[1];
-    const double scale_a = Interval(s).DerivativeScale(), scale_b = Interval(s + 1).DerivativeScale();
-    const double h = std::min(h_unit / scale_a, h_unit / scale_b);
-    Eigen::MatrixXd coefficients = Eigen::MatrixXd::Zero(order - 1, 2 * N + 1);
-    Eigen::MatrixXd Di = Eigen::MatrixXd::Identity(N + 1, N + 1);
-    for (int i = 1; i < order; ++i) {
-      Di = D_ * Di;
-      const double sigma_i = sigma * std::pow(h, order - i - 0.5);
-      // Segment s ends at its point k = 0 (global node (s + 1) N); segment s + 1 starts at its point k = N.
-      for (int k = 0; k <= N; ++k) {
-        coefficients(i - 1, NodeOf(s, k) - s * N) += std::pow(scale_a, i) * Di(0, k) / sigma_i;
-        coefficients(i - 1, NodeOf(s + 1, k) - s * N) -= std::pow(scale_b, i) * Di(N, k) / sigma_i;
-      }
-    }
-    return coefficients;
+    return internal::SmoothnessJumpRows(basis_, D_, Interval(s), Interval(s + 1), order, sigma);
   }
 
   /// Holds the given entries of every node's control constant (known inputs, e.g. a measured
@@ -436,22 +421,8 @@ class PseudoSpectralProblem {
     }
   }
 
-  // Rows sqrt(w_q L/2) u^(m)(t_q) over the controls of segment s in point order k = 0..N: their
-  // squared sum is ∫_s |u^(m)|² dt, exactly (Gauss–Legendre with N − m + 1 points).
   Eigen::MatrixXd SmoothnessRows(int order, int s, int points = 0) const {
-    const int N = degree_;
-    Eigen::MatrixXd Dm = Eigen::MatrixXd::Identity(N + 1, N + 1);
-    for (int i = 0; i < order; ++i) Dm = D_ * Dm;
-    const int nq = points > 0 ? points : N - order + 1;
-    const cheb::QuadratureRule rule = cheb::GaussLegendre(nq);
-    Eigen::RowVectorXd row(N + 1);
-    const double scale = std::pow(Interval(s).DerivativeScale(), order);
-    Eigen::MatrixXd coefficients(nq, N + 1);
-    for (int q = 0; q < nq; ++q) {
-      basis_.InterpolationRow(rule.nodes[q], row);
-      coefficients.row(q) = std::sqrt(rule.weights[q] * Length(s) / 2) * scale * (row * Dm);
-    }
-    return coefficients;
+    return internal::SmoothnessRows(basis_, D_, Interval(s), order, points);
   }
 
   // Puts node g's quaternion on the manifold once (the block must already be in the problem).
