@@ -393,6 +393,31 @@ double TotalCost(ceres::Problem& cp) {
   return cost;
 }
 
+// DerivativeMeasurementCost on a vector part that is a polynomial of the segment's degree: the
+// derivative row is exact, so h(x'(t)) = x'(t) − (the closed-form derivative) vanishes to rounding
+// (1e-12) at any t, and its Jacobian (w'_k per node, through the Jets) matches differences.
+struct RateResidual {
+  Eigen::Vector4d expected;
+  template <typename T>
+  bool operator()(const T* x_dot, T* r) const {
+    for (int i = 0; i < 4; ++i) r[i] = x_dot[i] - T(expected[i]);
+    return true;
+  }
+};
+
+TEST(PseudoSpectralProblem, DerivativeMeasurementIsExactOnPolynomials) {
+  PseudoSpectralProblem<UnicycleModel> problem(UnicycleModel{}, {0.0, 0.4, 1.1, 2.0}, 5);
+  const auto x = [](double t) { return Eigen::Vector4d(t * t * t, 2 - t, 0.5 * t * t, std::pow(t, 5)); };
+  const auto x_dot = [](double t) { return Eigen::Vector4d(3 * t * t, -1, t, 5 * std::pow(t, 4)); };
+  for (int g = 0; g < problem.num_nodes(); ++g) {
+    problem.SetNode(g, x(problem.NodeTime(g)), Eigen::Matrix3d::Identity(), Eigen::Vector2d::Zero());
+  }
+  for (double t : {0.0, 0.25, 0.4, 0.93, 2.0}) problem.AddDerivativeMeasurement(t, RateResidual{x_dot(t)}, 4);
+  EXPECT_LT(TotalCost(problem.ceres_problem()), 1e-20);
+  for (int g = 0; g < problem.num_nodes(); ++g) problem.Vector(g)[1] += 0.01 * g;  // off the polynomial
+  ExpectJacobianMatchesDifferences(problem);
+}
+
 // The prior is ∫ |u^(m)|² dt / σ² exactly (Ceres' cost is half of it), against closed forms; the
 // quadrature is exact, so the match is to rounding (1e-12 relative).
 TEST(PseudoSpectralProblem, ControlSmoothnessPriorIsTheExactIntegral) {
