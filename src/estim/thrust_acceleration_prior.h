@@ -1,6 +1,6 @@
 #pragma once
 // The quadrotor estimator's prior on the collective rotor speed (QuadrotorEstimateOptions::thrust_prior;
-// docs/estimator.md, "The collective's prior"), built from the pilot solution. Implementation header of
+// docs/estimator.md, "The algorithm", step 5), built from the pilot solution. Implementation header of
 // src/estim (not installed).
 
 #include "cheval/estim/models.h"

@@ -31,7 +31,7 @@ struct PoseSample {
   Eigen::Quaterniond q;
 };
 
-/// The estimator's options, one default set for every scenario (docs/estimator.md, "Defaults", says
+/// The estimator's options, one default set for every scenario (docs/estimator.md, "The algorithm", says
 /// why each is what it is). The estimator runs: a pilot solve with the rotor prior at
 /// sigma_rotor_rate everywhere → σ of the rotor prior per segment from the pilot (empirical Bayes) →
 /// the solve to convergence.
@@ -52,7 +52,7 @@ struct QuadrotorEstimateOptions {
   /// AdaptiveRotorPriorSigma), rad/s² per s^(1/2) (> 0).
   double adaptive_rotor_prior_floor = 30;
   /// After the pilot, the collective rotor speed's prior is the Matérn-3/2 prior on the world-frame
-  /// thrust acceleration (docs/estimator.md, "The collective's prior"); the differential (roll,
+  /// thrust acceleration (docs/estimator.md, "The algorithm", step 5); the differential (roll,
   /// pitch, yaw) components keep the rotor prior. false: the collective keeps the rotor prior too.
   bool thrust_prior = true;
   double thrust_prior_max_rate = 6.0;  ///< rad/s (> 0): the bound of the thrust prior's λ_a

@@ -2,7 +2,7 @@
 /// \file
 /// ThrustAccelerationCost: rows linear in the world-frame thrust acceleration of a set of nodes — the
 /// residual of the quadrotor estimator's Matérn prior on the collective (docs/estimator.md, "The
-/// collective's prior").
+/// algorithm", step 5).
 ///
 /// Contract. With f_k = (k_F/m) Σ_i Ω_ik² R_k e3 the thrust acceleration of node k (rotor speeds Ω_k,
 /// R_k from the quaternion block (x, y, z, w), world frame), coefficient rows C_a per world axis a
