@@ -1,23 +1,19 @@
 // Measured figures of docs/estimator.md (a plain program: it prints tables, it does not assert).
-//   quadrotor_estimate [VEHICLE_JSON] [--seeds N] [--scaling]
-// 1. Every scenario x seeds 1..N (default 3; --first-seed K: K..N): per-motor mean rotor-speed error (rpm, %), pose and
-//    velocity RMSE, states, iterations, seconds (one core).
-// 2. --scaling: figure-eight flights of 10 s .. 300 s at the default segment length: seconds per state.
-// Options (defaults: QuadrotorEstimateOptions): --duration S, --degree N, --segment S, --order M and
-// --sigma-u σ (rotor smoothness prior; the pilot's with the adaptive prior), --fixed-prior (σ_u
-// everywhere, no empirical Bayes), --floor σ and --pilot-iterations K (adaptive prior),
-// --no-thrust-prior (the collective's random-walk rotor prior instead of the thrust-acceleration one),
-// --sigma-p/-v/-w/-r σ (collocation), --trust-radius R, --window S (initialisation), --only SCENARIO,
-// --first-seed K (seeds K..N), --thrust-rounds K, --thrust-order M, --motion-prior (variants of the thrust prior),
-// --max-iterations K, --ftol / --gtol / --ptol X (Ceres' tolerances),
-// --full-report (Ceres' report of the final solve, with stage times), --dump PREFIX (writes
-// PREFIX_<scenario>_<seed>.txt: t, estimated rotor 0..3, true rotor 0..3,
-// estimated and true quaternion w x y z).
+//   quadrotor_estimate [VEHICLE_JSON] [--seeds N] [--first-seed K] [--only SCENARIO] [--duration S]
+//                      [--degree N] [--segment S] [--scaling]
+// 1. Every scenario (or --only one) x seeds K..N (default 1..3): per-motor mean rotor-speed error
+//    (rpm, %), pose and velocity RMSE, states, iterations, seconds (one core); the worst motor.
+// 2. --scaling: figure-eight flights of 10 s .. 300 s: seconds per state.
+// --duration: flight length (default 10 s); --degree, --segment: QuadrotorEstimateOptions' fields
+// (default: the struct's). VEHICLE_JSON defaults to the shipped vehicle file.
 #include <cstdio>
-#include <cstring>
+#include <cstdlib>
+#include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
+#include "cheval/estim/quadrotor_data.h"
 #include "cheval/estim/quadrotor_estimator.h"
 #include "cheval/estim/quadrotor_scoring.h"
 #include "cheval/estim/vehicle.h"
@@ -33,7 +29,7 @@ struct Row {
 };
 
 Row Run(const estim::Vehicle& vehicle, sim::QuadrotorScenario scenario, uint64_t seed, double duration,
-        const estim::QuadrotorEstimateOptions& options, const std::string& dump = "") {
+        const estim::QuadrotorEstimateOptions& options) {
   sim::QuadrotorSimOptions so;
   so.scenario = scenario;
   so.seed = seed;
@@ -44,72 +40,75 @@ Row Run(const estim::Vehicle& vehicle, sim::QuadrotorScenario scenario, uint64_t
   Row row;
   row.estimate = estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, options, times);
   row.errors = estim::CompareWithTruth(row.estimate, data.truth);
-  if (!dump.empty()) {  // t, estimated rotor 0..3, true rotor 0..3 (rad/s) at the truth times
-    std::FILE* f = std::fopen((dump + "_" + std::string(sim::ToString(scenario)) + "_" + std::to_string(seed) + ".txt").c_str(), "w");
-    for (size_t i = 0; i < row.estimate.samples.size() && i < data.truth.size(); ++i) {
-      const auto& e = row.estimate.samples[i];
-      const auto& g = data.truth[i];
-      const Eigen::Quaterniond qe(e.R);
-      std::fprintf(f, "%.3f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", e.t,
-                   e.rotor[0], e.rotor[1], e.rotor[2], e.rotor[3], g.rotor[0], g.rotor[1], g.rotor[2], g.rotor[3],
-                   qe.w(), qe.x(), qe.y(), qe.z(), g.q.w(), g.q.x(), g.q.y(), g.q.z());
-    }
-    std::fclose(f);
-  }
   return row;
+}
+
+// The command line (see the top of the file); exits with a message on anything else.
+struct Arguments {
+  std::string vehicle_path = CHEVAL_DEFAULT_VEHICLE;
+  int seeds = 3, first_seed = 1;
+  bool scaling = false;
+  double duration = 10.0;
+  std::string only;
+  estim::QuadrotorEstimateOptions options;
+};
+
+[[noreturn]] void Usage(const std::string& problem) {
+  std::fprintf(stderr,
+               "quadrotor_estimate: %s\nusage: quadrotor_estimate [VEHICLE_JSON] [--seeds N] [--first-seed K] "
+               "[--only SCENARIO] [--duration S] [--degree N] [--segment S] [--scaling]\n",
+               problem.c_str());
+  std::exit(2);
+}
+
+Arguments Parse(int argc, char** argv) {
+  Arguments a;
+  const std::map<std::string, std::function<void(const std::string&)>> with_value = {
+      {"--seeds", [&](const std::string& v) { a.seeds = std::stoi(v); }},
+      {"--first-seed", [&](const std::string& v) { a.first_seed = std::stoi(v); }},
+      {"--only", [&](const std::string& v) { a.only = v; }},
+      {"--duration", [&](const std::string& v) { a.duration = std::stod(v); }},
+      {"--degree", [&](const std::string& v) { a.options.degree = std::stoi(v); }},
+      {"--segment", [&](const std::string& v) { a.options.segment_s = std::stod(v); }},
+  };
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--scaling") {
+      a.scaling = true;
+    } else if (const auto it = with_value.find(arg); it != with_value.end()) {
+      if (i + 1 >= argc) Usage(arg + " needs a value");
+      try {
+        it->second(argv[++i]);
+      } catch (const std::exception&) {
+        Usage("bad value '" + std::string(argv[i]) + "' for " + arg);
+      }
+    } else if (arg.rfind("--", 0) == 0) {
+      Usage("unknown option " + arg);
+    } else {
+      a.vehicle_path = arg;
+    }
+  }
+  if (!a.only.empty() && !sim::QuadrotorScenarioFromString(a.only)) Usage("unknown scenario " + a.only);
+  return a;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string vehicle_path = CHEVAL_DEFAULT_VEHICLE;
-  int seeds = 3;
-  int first_seed = 1;
-  bool scaling = false;
-  double duration = 10.0;
-  std::string only, dump;
-  bool full_report = false;
-  estim::QuadrotorEstimateOptions options;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--seeds") && i + 1 < argc) seeds = std::stoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--scaling")) scaling = true;
-    else if (!std::strcmp(argv[i], "--duration") && i + 1 < argc) duration = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--degree") && i + 1 < argc) options.degree = std::stoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--segment") && i + 1 < argc) options.segment_s = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--order") && i + 1 < argc) options.rotor_prior_order = std::stoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--sigma-u") && i + 1 < argc) options.sigma_rotor_rate = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--sigma-v") && i + 1 < argc) options.sigma_acceleration = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--sigma-w") && i + 1 < argc) options.sigma_angular_acceleration = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--sigma-p") && i + 1 < argc) options.sigma_position_rate = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--sigma-r") && i + 1 < argc) options.sigma_rotation_rate = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--fixed-prior")) options.adaptive_rotor_prior = false;
-    else if (!std::strcmp(argv[i], "--floor") && i + 1 < argc) options.adaptive_rotor_prior_floor = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--pilot-iterations") && i + 1 < argc) options.pilot_iterations = std::stoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--no-thrust-prior")) options.thrust_prior = false;
-    else if (!std::strcmp(argv[i], "--thrust-rounds") && i + 1 < argc) options.thrust_prior_rounds = std::stoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--thrust-order") && i + 1 < argc) options.thrust_prior_order = std::stoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--motion-prior")) options.motion_prior = true;
-    else if (!std::strcmp(argv[i], "--max-iterations") && i + 1 < argc) options.max_iterations = std::stoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--ftol") && i + 1 < argc) options.function_tolerance = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--gtol") && i + 1 < argc) options.gradient_tolerance = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--ptol") && i + 1 < argc) options.parameter_tolerance = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--first-seed") && i + 1 < argc) first_seed = std::stoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--full-report")) full_report = true;
-    else if (!std::strcmp(argv[i], "--trust-radius") && i + 1 < argc) options.initial_trust_region_radius = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--window") && i + 1 < argc) options.initial_window_s = std::stod(argv[++i]);
-    else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
-    else if (!std::strcmp(argv[i], "--dump") && i + 1 < argc) dump = argv[++i];
-    else vehicle_path = argv[i];
-  }
-  const estim::Vehicle vehicle = estim::ReadVehicle(vehicle_path);
-  if (!scaling) {
+  const Arguments args = Parse(argc, argv);
+  const estim::QuadrotorEstimateOptions& options = args.options;
+  const int seeds = args.seeds, first_seed = args.first_seed;
+  const double duration = args.duration;
+  const std::string& only = args.only;
+  const estim::Vehicle vehicle = estim::ReadVehicle(args.vehicle_path);
+  if (!args.scaling) {
     std::printf("%-11s %4s %6s %4s %7s | %-31s | %-27s | %8s %8s %8s\n", "scenario", "seed", "states", "it", "sec",
                 "rotor error rpm (motor 0..3)", "rotor error % (motor 0..3)", "pos m", "rot deg", "vel m/s");
     double worst = 0;
     for (sim::QuadrotorScenario scenario : sim::AllQuadrotorScenarios()) {
       if (!only.empty() && sim::ToString(scenario) != only) continue;
       for (int seed = first_seed; seed <= seeds; ++seed) {
-        const Row r = Run(vehicle, scenario, seed, duration, options, dump);
+        const Row r = Run(vehicle, scenario, seed, duration, options);
         const auto& e = r.errors;
         std::printf("%-11s %4d %6d %4d %7.3f | %7.2f %7.2f %7.2f %7.2f | %6.3f %6.3f %6.3f %6.3f | %8.4f %8.3f %8.4f%s\n",
                     std::string(sim::ToString(scenario)).c_str(), seed, r.estimate.states, r.estimate.iterations,
@@ -118,7 +117,6 @@ int main(int argc, char** argv) {
                     e.rotor_error_percent[3], e.position_rmse_m, e.rotation_rmse_deg, e.velocity_rmse_mps,
                     r.estimate.converged ? "" : "  (not converged)");
         worst = std::max(worst, e.rotor_error_percent.maxCoeff());
-        if (full_report) std::printf("%s\n", r.estimate.solver_full_report.c_str());
       }
     }
     std::printf("worst per-motor mean rotor-speed error: %.3f %%\n", worst);

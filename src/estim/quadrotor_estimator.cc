@@ -6,15 +6,15 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <limits>
 
 #include <Eigen/Dense>
 
 #include "cheval/cheb/chebyshev.h"
 #include "cheval/common/error.h"
+#include "cheval/common/options.h"
 #include "cheval/estim/problem.h"
-#include "cheval/estim/thrust_vector_prior.h"
 #include "cheval/lie/so3.h"
+#include "thrust_acceleration_prior.h"
 
 namespace cheval::estim {
 namespace {
@@ -128,260 +128,51 @@ std::vector<double> AdaptiveRotorPriorSigma(const std::vector<double>& energy, i
   return sigma;
 }
 
+void QuadrotorEstimateOptions::Validate() const {
+  const OptionCheck check("QuadrotorEstimateOptions");
+  const auto positive = [](double x) { return x > 0 && std::isfinite(x); };
+  check(degree >= 2 && degree <= 64, "degree", "must be in [2, 64], got {}", degree);
+  check(positive(segment_s), "segment_s", "must be a positive number of seconds, got {}", segment_s);
+  check(positive(sigma_position_rate), "sigma_position_rate", "must be > 0, got {}", sigma_position_rate);
+  check(positive(sigma_acceleration), "sigma_acceleration", "must be > 0, got {}", sigma_acceleration);
+  check(positive(sigma_angular_acceleration), "sigma_angular_acceleration", "must be > 0, got {}",
+        sigma_angular_acceleration);
+  check(positive(sigma_rotation_rate), "sigma_rotation_rate", "must be > 0, got {}", sigma_rotation_rate);
+  check(positive(sigma_rotor_rate), "sigma_rotor_rate", "must be > 0, got {}", sigma_rotor_rate);
+  check(pilot_iterations >= 1, "pilot_iterations", "must be >= 1, got {}", pilot_iterations);
+  check(positive(adaptive_rotor_prior_floor), "adaptive_rotor_prior_floor", "must be > 0, got {}",
+        adaptive_rotor_prior_floor);
+  check(positive(thrust_prior_max_rate), "thrust_prior_max_rate", "must be > 0, got {}", thrust_prior_max_rate);
+  check(positive(huber_pixels), "huber_pixels", "must be > 0, got {}", huber_pixels);
+  check(positive(initial_window_s), "initial_window_s", "must be > 0, got {}", initial_window_s);
+  check(positive(initial_trust_region_radius), "initial_trust_region_radius", "must be > 0, got {}",
+        initial_trust_region_radius);
+  check(max_iterations >= 1, "max_iterations", "must be >= 1, got {}", max_iterations);
+  check(positive(function_tolerance), "function_tolerance", "must be > 0, got {}", function_tolerance);
+  check(positive(gradient_tolerance), "gradient_tolerance", "must be > 0, got {}", gradient_tolerance);
+  check(positive(parameter_tolerance), "parameter_tolerance", "must be > 0, got {}", parameter_tolerance);
+  check(threads >= 1, "threads", "must be >= 1, got {}", threads);
+}
+
 namespace {
 
-// Rows C_a V_a (axis a = x, y, z) of the velocities V_a of the given nodes (their velocity blocks):
-// linear, so the Jacobian is constant. With C_a the Gauss–Legendre rows of (D + λ_a)² D over a
-// segment, the squared sum is ∫_s |(D + λ_a)² v_a'|² dt exactly.
-class VelocityRowsCost : public ceres::CostFunction {
- public:
-  VelocityRowsCost(Problem& p, const std::vector<int>& nodes, std::array<Eigen::MatrixXd, 3> coefficients)
-      : coefficients_(std::move(coefficients)) {
-    for (int g : nodes) {
-      blocks_.push_back(p.Vector(g) + 3);
-      mutable_parameter_block_sizes()->push_back(3);
-    }
-    set_num_residuals(3 * static_cast<int>(coefficients_[0].rows()));
-  }
-  const std::vector<double*>& blocks() const { return blocks_; }
-  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const int rows = static_cast<int>(coefficients_[0].rows()), n = static_cast<int>(blocks_.size());
-    for (int a = 0; a < 3; ++a) {
-      for (int q = 0; q < rows; ++q) {
-        double r = 0;
-        for (int k = 0; k < n; ++k) r += coefficients_[a](q, k) * parameters[k][a];
-        residuals[a * rows + q] = r;
-      }
-    }
-    if (jacobians) {
-      for (int k = 0; k < n; ++k) {
-        if (!jacobians[k]) continue;
-        Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> J(jacobians[k], 3 * rows, 3);
-        J.setZero();
-        for (int a = 0; a < 3; ++a) {
-          for (int q = 0; q < rows; ++q) J(a * rows + q, a) = coefficients_[a](q, k);
-        }
-      }
-    }
-    return true;
-  }
-
- private:
-  std::array<Eigen::MatrixXd, 3> coefficients_;
-  std::vector<double*> blocks_;
-};
-
-// The parts a Matérn prior of order m (2: Matérn-3/2, 3: Matérn-5/2) takes from the pilot, per world
-// axis a, for a quantity x(t) known at the nodes of each segment (X_s, N + 1 x 3) through the
-// Gauss–Legendre rows q_s[j] of its j-th derivative (j = 0..m; |q_s[j] X_s|² = ∫_s |x^(j)|² dt):
-// λ_a matched to the root-mean-square frequency ν = sqrt(−∫x''x / ∫x²) of the pilot's x_a (a
-// Matérn-3/2 process has ν = λ, a Matérn-5/2 one ν = λ/√3; at most max_rate), the rows of
-// (D + λ_a)^m over each segment, and σ_s, the maximum-likelihood intensity of segment s (3 axes of
-// N + 1 − m increments).
-struct MaternParts {
-  Eigen::Vector3d lambda;
-  std::vector<std::array<Eigen::MatrixXd, 3>> rows;  // per segment and axis
-  std::vector<double> sigma;                         // per segment
-};
-
-MaternParts FitMaternParts(const std::vector<std::array<Eigen::MatrixXd, 4>>& q, const std::vector<Eigen::MatrixXd>& X,
-                           int m, int N, double max_rate) {
-  const int S = static_cast<int>(X.size());
-  Eigen::Vector3d num = Eigen::Vector3d::Zero(), den = Eigen::Vector3d::Zero();
-  for (int s = 0; s < S; ++s) {
-    const Eigen::MatrixXd A0 = q[s][0] * X[s], A2 = q[s][2] * X[s];
-    for (int a = 0; a < 3; ++a) {
-      num[a] -= A2.col(a).dot(A0.col(a));  // ∫ x'' x = −∫ |x'|² + ends
-      den[a] += A0.col(a).squaredNorm();
-    }
-  }
-  MaternParts parts;
-  const double rms_to_lambda = m == 3 ? std::sqrt(3.0) : 1.0;
-  for (int a = 0; a < 3; ++a) {
-    parts.lambda[a] =
-        rms_to_lambda * std::sqrt(std::clamp(den[a] > 0 ? num[a] / den[a] : 0.0, 0.0, max_rate * max_rate));
-  }
-  const double binomial[4][4] = {{1, 0, 0, 0}, {1, 1, 0, 0}, {1, 2, 1, 0}, {1, 3, 3, 1}};
-  parts.rows.resize(S);
-  parts.sigma.resize(S);
-  for (int s = 0; s < S; ++s) {
-    double e = 0;
-    for (int a = 0; a < 3; ++a) {
-      parts.rows[s][a] = Eigen::MatrixXd::Zero(N + 1, N + 1);
-      for (int j = 0; j <= m; ++j) parts.rows[s][a] += binomial[m][j] * std::pow(parts.lambda[a], m - j) * q[s][j];
-      e += (parts.rows[s][a] * X[s].col(a)).squaredNorm();
-    }
-    parts.sigma[s] = std::max(std::sqrt(e / (3.0 * (N + 1 - m))), 1e-9);
-  }
-  return parts;
+// The rotor speeds' components the rotor prior acts on: the collective and the roll, pitch and yaw
+// combinations (the mixer's rows, orthonormal columns), so that with one σ for all four it is the
+// per-rotor prior.
+Eigen::Matrix4d RotorBasis() {
+  Eigen::Matrix4d basis;
+  basis << 1, 1, -1, -1,  //
+      1, 1, 1, 1,         //
+      1, -1, 1, -1,       //
+      1, -1, -1, 1;
+  return 0.5 * basis;  // columns: collective, roll, pitch, yaw
 }
 
-// W with |W y|² = yᵀ P⁻¹ y for the stationary covariance P of the process's first state
-// y = (x, x', .., x^(m−1)): with the energy of (D + λ)^m x, the exact density of the stationary
-// process. From the spectrum σ² / (λ² + ω²)^m: m = 2: P = diag(1/(4λ³), 1/(4λ)) σ²; m = 3:
-// P = [[3, 0, −λ²], [0, λ², 0], [−λ², 0, 3λ⁴]] σ² / (16λ⁵).
-Eigen::MatrixXd StationaryStartWhitening(int m, double lambda, double sigma) {
-  const double l = lambda;
-  Eigen::MatrixXd cov(m, m);
-  if (m == 2) {
-    cov << 1 / (4 * l * l * l), 0, 0, 1 / (4 * l);
-  } else {
-    cov << 3, 0, -l * l, 0, l * l, 0, -l * l, 0, 3 * l * l * l * l;
-    cov /= 16 * std::pow(l, 5);
-  }
-  cov *= sigma * sigma;
-  const Eigen::MatrixXd info = cov.inverse();
-  return Eigen::LLT<Eigen::MatrixXd>(info).matrixL().transpose();
-}
-
-// The kinematic acceleration's prior (QuadrotorEstimateOptions::motion_prior): per world axis a, a
-// Matérn-3/2 process on v_a', ∫ |(D + λ_a)² v_a'|² dt / σ_s² per segment, λ_a and σ_s from the
-// pilot as in AddThrustAccelerationPrior, v' and v'' continuous at the breakpoints and the
-// stationary law of (v', v'') at the first time. The collective rotor speed then follows from
-// the collocation of v' = f − g − drag.
-std::vector<ceres::ResidualBlockId> AddMotionPrior(Problem& problem, const QuadrotorEstimateOptions& options) {
-  std::vector<ceres::ResidualBlockId> ids;
-  const int S = problem.num_segments(), N = options.degree;
-  const int m = options.thrust_prior_order;  // 2: Matérn-3/2 on v', 3: Matérn-5/2
-  std::vector<Eigen::MatrixXd> V(S);
-  std::vector<std::array<Eigen::MatrixXd, 4>> Q(S);  // GL rows of v', v'', ... (the velocity's 1st .. (m+1)-th derivatives)
-  for (int s = 0; s < S; ++s) {
-    V[s].resize(N + 1, 3);
-    for (int k = 0; k <= N; ++k) {
-      V[s].row(k) = Eigen::Map<const Eigen::Vector3d>(problem.Vector(problem.NodeOf(s, k)) + 3).transpose();
-    }
-    for (int j = 0; j <= m; ++j) Q[s][j] = problem.SmoothnessMatrix(j + 1, s, N + 1);
-  }
-  const MaternParts parts = FitMaternParts(Q, V, m, N, options.thrust_prior_max_rate);
-  const std::vector<std::array<Eigen::MatrixXd, 3>>& rows = parts.rows;
-  const std::vector<double>& sigma_f = parts.sigma;
-  for (int s = 0; s < S; ++s) {
-    std::vector<int> nodes;
-    for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(s, k));
-    std::array<Eigen::MatrixXd, 3> r;
-    for (int a = 0; a < 3; ++a) r[a] = rows[s][a] / sigma_f[s];
-    auto* cost = new VelocityRowsCost(problem, nodes, r);
-    ids.push_back(problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks()));
-  }
-  for (int s = 0; s + 1 < S; ++s) {  // v' and v'' continuous at the inner breakpoints
-    std::vector<int> nodes;
-    for (int g = s * N; g <= (s + 2) * N; ++g) nodes.push_back(g);
-    const Eigen::MatrixXd J = problem.SmoothnessJumpMatrix(m + 1, s, std::sqrt(sigma_f[s] * sigma_f[s + 1]));
-    auto* cost = new VelocityRowsCost(problem, nodes, {J, J, J});
-    ids.push_back(problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks()));
-  }
-  const detail::TimeRow row = problem.RowAt(problem.start_time());
-  const Eigen::MatrixXd D = cheb::DifferentiationMatrix(N);
-  const double scale = 2.0 / (problem.breakpoints()[1] - problem.breakpoints()[0]);
-  Eigen::MatrixXd R0(m, N + 1);  // rows of v', v'', v''' at t0
-  R0.row(0) = row.dw;
-  for (int i = 1; i < m; ++i) R0.row(i) = scale * R0.row(i - 1) * D;
-  std::array<Eigen::MatrixXd, 3> C;
-  for (int a = 0; a < 3; ++a) C[a] = StationaryStartWhitening(m, parts.lambda[a], sigma_f[0]) * R0;
-  std::vector<int> nodes;
-  for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(0, k));
-  auto* cost = new VelocityRowsCost(problem, nodes, C);
-  ids.push_back(problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks()));
-  return ids;
-}
-
-// The collective rotor speed's prior after the pilot (QuadrotorEstimateOptions::thrust_prior,
-// docs/estimator.md "Defaults"): per world axis a, a Matérn-3/2 process on the thrust acceleration
-// a = (k_F ΣΩ²/m) R e3 − ḡ, ∫|(D + λ_a)² a_a|² dt / σ_s² per segment, with λ_a the pilot's
-// root-mean-square frequency on that axis, σ_s the maximum-likelihood intensity of segment s, the
-// rate of a continuous at the breakpoints and the stationary law of (a, a') at the first time.
-std::vector<ceres::ResidualBlockId> AddThrustAccelerationPrior(Problem& problem, const Vehicle& vehicle,
-                                                               const QuadrotorEstimateOptions& options) {
-  std::vector<ceres::ResidualBlockId> ids;
-  const int S = problem.num_segments(), N = options.degree;
-  const double k_over_m = vehicle.quadrotor.thrust_coefficient / vehicle.quadrotor.mass_kg;
-  const Eigen::Vector3d gbar(0, 0, vehicle.quadrotor.gravity_mps2);
-  const int m = options.thrust_prior_order;  // 2: Matérn-3/2, (D + λ)² a; 3: Matérn-5/2, (D + λ)³ a
-  std::vector<Eigen::MatrixXd> F(S);  // pilot's f − ḡ at the nodes
-  std::vector<std::array<Eigen::MatrixXd, 4>> Q(S);  // GL rows of 1, D, D², D³
-  for (int s = 0; s < S; ++s) {
-    F[s].resize(N + 1, 3);
-    for (int k = 0; k <= N; ++k) {
-      const int g = problem.NodeOf(s, k);
-      F[s].row(k) = (ThrustVectorSmoothnessCost::ThrustAcceleration(problem.Control(g), problem.Quaternion(g), k_over_m) -
-                     gbar).transpose();
-    }
-    for (int j = 0; j <= m; ++j) Q[s][j] = problem.SmoothnessMatrix(j, s, N + 1);
-  }
-  const MaternParts parts = FitMaternParts(Q, F, m, N, options.thrust_prior_max_rate);
-  const std::vector<std::array<Eigen::MatrixXd, 3>>& rows = parts.rows;
-  const std::vector<double>& sigma_f = parts.sigma;
-  // The rows act on f; the prior is on f − ḡ: offsets −λ^m ḡ_a (the constant's only surviving term).
-  std::vector<Eigen::MatrixXd> offsets(S, Eigen::MatrixXd(N + 1, 3));
-  for (int s = 0; s < S; ++s) {
-    for (int a = 0; a < 3; ++a) offsets[s].col(a) = -std::pow(parts.lambda[a], m) * gbar[a] * Q[s][0].rowwise().sum();
-  }
-  for (int s = 0; s < S; ++s) {
-    std::vector<int> nodes;
-    for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(s, k));
-    auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, rows[s], offsets[s], k_over_m);
-    cost->set_weight(1.0 / sigma_f[s]);
-    ids.push_back(problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks()));
-  }
-  // f' (and f'' for m = 3) continuous at the inner breakpoints (as AddControlSmoothnessPrior's jumps).
-  for (int s = 0; s + 1 < S; ++s) {
-    std::vector<int> nodes;
-    for (int g = s * N; g <= (s + 2) * N; ++g) nodes.push_back(g);
-    auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, problem.SmoothnessJumpMatrix(m, s, 1.0), k_over_m);
-    cost->set_weight(1.0 / std::sqrt(sigma_f[s] * sigma_f[s + 1]));
-    ids.push_back(problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks()));
-  }
-  // The stationary law of the process's first state (a, a', .., a^(m−1)) at t0
-  // (StationaryStartWhitening).
-  const detail::TimeRow row = problem.RowAt(problem.start_time());
-  Eigen::MatrixXd R0(m, N + 1);  // rows of a, a', a'' at t0 in the first segment's point order
-  R0.row(0) = row.w;
-  R0.row(1) = row.dw;
-  if (m == 3) {
-    const Eigen::MatrixXd D = cheb::DifferentiationMatrix(N);
-    const double scale = 2.0 / (problem.breakpoints()[1] - problem.breakpoints()[0]);
-    R0.row(2) = scale * row.dw * D;
-  }
-  std::array<Eigen::MatrixXd, 3> C;
-  Eigen::MatrixXd o(m, 3);
-  for (int a = 0; a < 3; ++a) {
-    const Eigen::MatrixXd W = StationaryStartWhitening(m, parts.lambda[a], sigma_f[0]);
-    C[a] = W * R0;
-    o.col(a) = -W.col(0) * gbar[a];
-  }
-  std::vector<int> nodes;
-  for (int k = 0; k <= N; ++k) nodes.push_back(problem.NodeOf(0, k));
-  auto* cost = new ThrustVectorSmoothnessCost(problem, nodes, C, o, k_over_m);
-  ids.push_back(problem.ceres_problem().AddResidualBlock(cost, nullptr, cost->blocks()));
-  return ids;
-}
-
-}  // namespace
-
-QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Eigen::Vector3d>& landmarks,
-                                    const std::vector<PixelObservation>& pixels,
-                                    const std::vector<PoseSample>& initial, const QuadrotorEstimateOptions& options,
-                                    const std::vector<double>& query_times) {
-  const auto start = std::chrono::steady_clock::now();
-  if (options.degree < 2 || options.degree > 64) throw UsageError(fmt::format("--degree must be in [2, 64], got {}", options.degree));
-  if (!(options.segment_s > 0) || !std::isfinite(options.segment_s)) {
-    throw UsageError(fmt::format("--segment must be a positive number of seconds, got {}", options.segment_s));
-  }
-  if (options.pilot_iterations < 1) {
-    throw UsageError(fmt::format("the pilot solve needs >= 1 iteration, got {}", options.pilot_iterations));
-  }
-  if (!(options.adaptive_rotor_prior_floor > 0)) {
-    throw UsageError(fmt::format("the adaptive rotor-prior floor must be > 0, got {}", options.adaptive_rotor_prior_floor));
-  }
-  if (!(options.initial_trust_region_radius > 0)) {
-    throw UsageError(fmt::format("the initial trust-region radius must be > 0, got {}", options.initial_trust_region_radius));
-  }
-  if (options.thrust_prior_rounds < 1) {
-    throw UsageError(fmt::format("the thrust prior needs >= 1 empirical-Bayes round, got {}", options.thrust_prior_rounds));
-  }
-  if (options.thrust_prior_order < 2 || options.thrust_prior_order > 3) {
-    throw UsageError(fmt::format("the thrust prior's order must be 2 or 3, got {}", options.thrust_prior_order));
-  }
+// The measurement interval [t0, t1]; ComputeError for a landmark id outside the map, fewer than two
+// frame times or initial poses that do not cover the interval.
+std::pair<double, double> MeasurementSpan(const std::vector<Eigen::Vector3d>& landmarks,
+                                          const std::vector<PixelObservation>& pixels,
+                                          const std::vector<PoseSample>& initial) {
   if (pixels.empty()) throw ComputeError("no camera measurements");
   double t0 = pixels.front().t, t1 = pixels.front().t;
   for (const PixelObservation& m : pixels) {
@@ -399,41 +190,42 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
                                    initial.empty() ? 0.0 : initial.front().t, initial.empty() ? 0.0 : initial.back().t,
                                    t0, t1));
   }
-  const int segments = std::max(1, static_cast<int>(std::lround((t1 - t0) / options.segment_s)));
+  return {t0, t1};
+}
+
+// round((t1 − t0) / segment_s) equal segments (at least one).
+std::vector<double> Breakpoints(double t0, double t1, double segment_s) {
+  const int segments = std::max(1, static_cast<int>(std::lround((t1 - t0) / segment_s)));
   std::vector<double> breakpoints(segments + 1);
   for (int s = 0; s <= segments; ++s) breakpoints[s] = t0 + (t1 - t0) * s / segments;
   breakpoints.back() = t1;
-  Problem problem(QuadrotorModel{vehicle.quadrotor}, breakpoints, options.degree);
+  return breakpoints;
+}
 
-  // Initial values: the flatness-based fit of the front end's poses (FlatnessInitialState).
+// Initial values: the flatness-based fit of the front end's poses (FlatnessInitialState) at every
+// node; then the chart references.
+void SetInitialValues(Problem& problem, const QuadrotorParameters& vehicle, const std::vector<PoseSample>& initial,
+                      double window_s) {
   for (int g = 0; g < problem.num_nodes(); ++g) {
-    const QuadrotorStateEstimate x0 = FlatnessInitialState(vehicle.quadrotor, initial, problem.NodeTime(g),
-                                                           options.initial_window_s);
+    const QuadrotorStateEstimate x0 = FlatnessInitialState(vehicle, initial, problem.NodeTime(g), window_s);
     Eigen::VectorXd x(9);
     x << x0.p, x0.v, x0.w;
     problem.SetNode(g, x, x0.R, x0.rotor);
   }
   problem.SetChartReferences();
+}
 
+Eigen::Matrix<double, 12, 1> CollocationSigma(const QuadrotorEstimateOptions& o) {
   Eigen::Matrix<double, 12, 1> sigma;
-  sigma << Eigen::Vector3d::Constant(options.sigma_position_rate), Eigen::Vector3d::Constant(options.sigma_acceleration),
-      Eigen::Vector3d::Constant(options.sigma_angular_acceleration), Eigen::Vector3d::Constant(options.sigma_rotation_rate);
-  problem.AddCollocation(sigma);
-  // The rotor prior on the collective and the roll, pitch and yaw combinations of the rotor speeds
-  // (the mixer's rows, orthonormal): with one σ for all four it is the per-rotor prior.
-  Eigen::Matrix4d rotor_basis;
-  rotor_basis << 1, 1, -1, -1,  //
-      1, 1, 1, 1,               //
-      1, -1, 1, -1,             //
-      1, -1, -1, 1;
-  rotor_basis *= 0.5;  // columns: collective, roll, pitch, yaw
-  if (options.sigma_rotor_rate > 0) {
-    problem.AddControlSmoothnessPrior(options.rotor_prior_order, options.sigma_rotor_rate, rotor_basis);
-  }
+  sigma << Eigen::Vector3d::Constant(o.sigma_position_rate), Eigen::Vector3d::Constant(o.sigma_acceleration),
+      Eigen::Vector3d::Constant(o.sigma_angular_acceleration), Eigen::Vector3d::Constant(o.sigma_rotation_rate);
+  return sigma;
+}
 
-  const PinholeCamera& cam = vehicle.camera;
+// One measurement per frame time: the pixels of all its landmarks, Huber per landmark.
+void AddCameraMeasurements(Problem& problem, const PinholeCamera& cam, const std::vector<Eigen::Vector3d>& landmarks,
+                           const std::vector<PixelObservation>& pixels, const ceres::LossFunction* huber) {
   const double pixel_sigma = std::max(cam.pixel_noise_px, 0.1);  // a noise-free file still gets a finite weight
-  ceres::HuberLoss huber(options.huber_pixels);
   for (size_t i = 0; i < pixels.size();) {
     FrameProjection frame{PinholeCamera::BodyFromCamera().transpose(), cam.fx, cam.fy, cam.cx, cam.cy, 1.0 / pixel_sigma,
                           {}, {}};
@@ -443,25 +235,28 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
       frame.pixels.push_back(pixels[j].uv);
     }
     const int rows = static_cast<int>(2 * (j - i));
-    problem.AddMeasurement(pixels[i].t, std::move(frame), rows, 2, {0}, &huber);
+    problem.AddMeasurement(pixels[i].t, std::move(frame), rows, 2, {0}, huber);
     i = j;
   }
+}
 
-  // Progress after every iteration of every solve (the pilot's and the final one's).
-  class IterationProgress : public ceres::IterationCallback {
-   public:
-    explicit IterationProgress(const ProgressFn& progress) : progress_(progress) {}
-    ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
-      if (summary.iteration > 0) ReportProgress(progress_, "solver iterations", ++done_, 0);
-      return ceres::SOLVER_CONTINUE;
-    }
+// Progress after every iteration of every solve (the pilot's and the final one's).
+class IterationProgress : public ceres::IterationCallback {
+ public:
+  explicit IterationProgress(const ProgressFn& progress) : progress_(progress) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (summary.iteration > 0) ReportProgress(progress_, "solver iterations", ++done_, 0);
+    return ceres::SOLVER_CONTINUE;
+  }
 
-   private:
-    const ProgressFn& progress_;
-    int64_t done_ = 0;
-  } iteration_progress(options.progress);
+ private:
+  const ProgressFn& progress_;
+  int64_t done_ = 0;
+};
+
+ceres::Solver::Options SolverOptions(const QuadrotorEstimateOptions& options, IterationProgress* progress) {
   ceres::Solver::Options solver;
-  if (options.progress) solver.callbacks.push_back(&iteration_progress);
+  if (options.progress) solver.callbacks.push_back(progress);
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   solver.max_num_iterations = options.max_iterations;
   solver.num_threads = options.threads;
@@ -470,39 +265,30 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   solver.function_tolerance = options.function_tolerance;
   solver.gradient_tolerance = options.gradient_tolerance;
   solver.parameter_tolerance = options.parameter_tolerance;
-  const bool adaptive = options.adaptive_rotor_prior && options.sigma_rotor_rate > 0 && options.rotor_prior_order == 1;
-  if (adaptive) solver.max_num_iterations = options.pilot_iterations;
-  ceres::Solver::Summary summary = problem.Solve(solver);
-  int iterations = static_cast<int>(summary.iterations.size()) - 1;
-  if (adaptive) {  // empirical Bayes: σ per segment from the pilot's rotor speeds, then the solve
-    const int S = problem.num_segments();
-    std::vector<double> energy(S);
-    for (int s = 0; s < S; ++s) energy[s] = problem.ControlDerivativeEnergy(1, s);
-    const std::vector<double> segment_sigma = AdaptiveRotorPriorSigma(energy, options.degree, QuadrotorModel::kControlDim);
-    const bool thrust = options.thrust_prior;
-    const double off = std::numeric_limits<double>::infinity();  // weight 0
-    for (int s = 0; s < S; ++s) {
-      const double sigma_s = std::max(options.adaptive_rotor_prior_floor, segment_sigma[s]);
-      problem.SetControlSmoothnessSigmas(1, s, Eigen::Vector4d(thrust ? off : sigma_s, sigma_s, sigma_s, sigma_s));
-    }
-    std::vector<ceres::ResidualBlockId> thrust_blocks;
-    if (thrust) {
-      thrust_blocks = options.motion_prior ? AddMotionPrior(problem, options)
-                                           : AddThrustAccelerationPrior(problem, vehicle, options);
-    }
-    solver.max_num_iterations = options.max_iterations;
-    summary = problem.Solve(solver);
-    iterations += static_cast<int>(summary.iterations.size()) - 1;
-    for (int round = 1; thrust && round < options.thrust_prior_rounds; ++round) {
-      // Another empirical-Bayes round: λ_a and σ_s from the solution with the thrust prior.
-      for (ceres::ResidualBlockId id : thrust_blocks) problem.ceres_problem().RemoveResidualBlock(id);
-      thrust_blocks = options.motion_prior ? AddMotionPrior(problem, options)
-                                           : AddThrustAccelerationPrior(problem, vehicle, options);
-      summary = problem.Solve(solver);
-      iterations += static_cast<int>(summary.iterations.size()) - 1;
-    }
-  }
+  return solver;
+}
 
+// Empirical Bayes after the pilot: σ_s = max(floor, AdaptiveRotorPriorSigma) per segment from the
+// pilot's rotor rates; with thrust_prior the collective's rotor prior is replaced by the prior on
+// the thrust acceleration (thrust_acceleration_prior.h), else all four components keep σ_s.
+void SetPriorsFromPilot(Problem& problem, const QuadrotorParameters& vehicle, const QuadrotorEstimateOptions& options) {
+  const int S = problem.num_segments();
+  std::vector<double> energy(S);
+  for (int s = 0; s < S; ++s) energy[s] = problem.ControlDerivativeEnergy(1, s);
+  std::vector<double> sigma = AdaptiveRotorPriorSigma(energy, options.degree, QuadrotorModel::kControlDim);
+  for (double& x : sigma) x = std::max(options.adaptive_rotor_prior_floor, x);
+  Problem::ControlBasis basis = RotorBasis();
+  if (options.thrust_prior) {
+    problem.RemoveControlSmoothnessPrior(1);
+    basis = RotorBasis().rightCols<3>();  // the differential components
+    problem.AddControlSmoothnessPrior(1, options.sigma_rotor_rate, basis);
+    AddThrustAccelerationPrior(problem, vehicle, options.thrust_prior_max_rate);
+  }
+  for (int s = 0; s < S; ++s) problem.SetControlSmoothnessSigmas(1, s, Eigen::VectorXd::Constant(basis.cols(), sigma[s]));
+}
+
+QuadrotorEstimate Result(const Problem& problem, const ceres::Solver::Summary& summary, int iterations,
+                         const std::vector<double>& query_times) {
   QuadrotorEstimate out;
   out.states = problem.num_nodes();
   out.segments = problem.num_segments();
@@ -511,14 +297,47 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   out.converged = summary.termination_type == ceres::CONVERGENCE;
   out.solver_report = summary.BriefReport();
   out.solver_full_report = summary.FullReport();
-  out.start_time = t0;
-  out.end_time = t1;
+  out.start_time = problem.start_time();
+  out.end_time = problem.end_time();
   for (double t : query_times) {
-    if (t < t0 || t > t1) continue;
+    if (t < out.start_time || t > out.end_time) continue;
     const StateSample s = problem.Interpolate(t);
     out.samples.push_back({t, s.vector.segment<3>(0), s.vector.segment<3>(3), s.vector.segment<3>(6), s.rotation,
                            s.control.head<4>()});
   }
+  return out;
+}
+
+}  // namespace
+
+QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Eigen::Vector3d>& landmarks,
+                                    const std::vector<PixelObservation>& pixels,
+                                    const std::vector<PoseSample>& initial, const QuadrotorEstimateOptions& options,
+                                    const std::vector<double>& query_times) {
+  const auto start = std::chrono::steady_clock::now();
+  options.Validate();
+  const auto [t0, t1] = MeasurementSpan(landmarks, pixels, initial);
+  Problem problem(QuadrotorModel{vehicle.quadrotor}, Breakpoints(t0, t1, options.segment_s), options.degree);
+  SetInitialValues(problem, vehicle.quadrotor, initial, options.initial_window_s);
+  problem.AddCollocation(CollocationSigma(options));
+  problem.AddControlSmoothnessPrior(1, options.sigma_rotor_rate, RotorBasis());
+  const ceres::HuberLoss huber(options.huber_pixels);
+  AddCameraMeasurements(problem, vehicle.camera, landmarks, pixels, &huber);
+
+  IterationProgress progress(options.progress);
+  ceres::Solver::Options solver = SolverOptions(options, &progress);
+  // 1. The pilot: a few iterations with the rotor prior at sigma_rotor_rate everywhere.
+  solver.max_num_iterations = options.pilot_iterations;
+  ceres::Solver::Summary summary = problem.Solve(solver);
+  int iterations = static_cast<int>(summary.iterations.size()) - 1;
+  // 2. σ per segment (and the thrust prior) from the pilot's solution.
+  SetPriorsFromPilot(problem, vehicle.quadrotor, options);
+  // 3. The solve to convergence.
+  solver.max_num_iterations = options.max_iterations;
+  summary = problem.Solve(solver);
+  iterations += static_cast<int>(summary.iterations.size()) - 1;
+
+  QuadrotorEstimate out = Result(problem, summary, iterations, query_times);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }

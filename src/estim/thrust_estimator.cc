@@ -18,13 +18,14 @@
 #include <ceres/ceres.h>
 
 #include "cheval/common/error.h"
+#include "cheval/common/options.h"
 #include "cheval/estim/problem.h"
 
 namespace cheval::estim {
 namespace {
 
 constexpr double kRadPerSecondPerRpm = std::numbers::pi / 30.0;
-constexpr double kDidoRotorUnitRpm = 1e4;  // DIDO's kf and D use rotor speeds in 1e4 rpm (SOURCE.md)
+constexpr double kDidoRotorUnitRpm = 1e4;  // DIDO's kf and D use rotor speeds in 1e4 rpm (docs/estimator_real_data.md)
 constexpr double kDidoGravity = 9.8;       // Translation_stage.py: gravity = [0, 0, 9.8]
 
 // A comma-separated file with one header line: the rows as numbers, each with its line number.
@@ -157,30 +158,26 @@ struct SpecificForceResidual {
   }
 };
 
-void Validate(const ThrustEstimateOptions& o) {
-  if (o.degree < 2 || o.degree > 64) throw UsageError(fmt::format("--degree must be in [2, 64], got {}", o.degree));
-  auto positive = [](double x, const char* name) {
-    if (!(x > 0) || !std::isfinite(x)) throw UsageError(fmt::format("{} must be a positive number, got {}", name, x));
-  };
-  positive(o.segment_s, "--segment");
-  positive(o.position_rate_hz, "--position-rate");
-  positive(o.position_sigma_m, "--position-sigma");
-  positive(o.imu_sigma_mps2, "--imu-sigma");
-  positive(o.sigma_position_rate, "the p' collocation sigma");
-  positive(o.sigma_acceleration, "--sigma-acceleration");
-  if (!(o.position_noise_m >= 0) || !std::isfinite(o.position_noise_m)) {
-    throw UsageError(fmt::format("--position-noise must be >= 0, got {}", o.position_noise_m));
-  }
-  if (!(o.sigma_rotor_rate >= 0) || !std::isfinite(o.sigma_rotor_rate)) {
-    throw UsageError(fmt::format("--sigma-rotor-rate must be >= 0, got {}", o.sigma_rotor_rate));
-  }
-  if (!(std::abs(o.rotor_delay_s) <= 1.0)) {
-    throw UsageError(fmt::format("--rotor-delay must be within [-1, 1] s, got {}", o.rotor_delay_s));
-  }
-  if (o.max_iterations < 1) throw UsageError("max_iterations must be >= 1");
-}
-
 }  // namespace
+
+void ThrustEstimateOptions::Validate() const {
+  const OptionCheck check("ThrustEstimateOptions");
+  const auto positive = [](double x) { return x > 0 && std::isfinite(x); };
+  check(degree >= 2 && degree <= 64, "degree", "must be in [2, 64], got {}", degree);
+  check(positive(segment_s), "segment_s", "must be a positive number, got {}", segment_s);
+  check(positive(position_rate_hz), "position_rate_hz", "must be a positive number, got {}", position_rate_hz);
+  check(positive(position_sigma_m), "position_sigma_m", "must be a positive number, got {}", position_sigma_m);
+  check(position_noise_m >= 0 && std::isfinite(position_noise_m), "position_noise_m", "must be >= 0, got {}",
+        position_noise_m);
+  check(positive(imu_sigma_mps2), "imu_sigma_mps2", "must be a positive number, got {}", imu_sigma_mps2);
+  check(positive(sigma_position_rate), "sigma_position_rate", "must be a positive number, got {}", sigma_position_rate);
+  check(positive(sigma_acceleration), "sigma_acceleration", "must be a positive number, got {}", sigma_acceleration);
+  check(sigma_rotor_rate >= 0 && std::isfinite(sigma_rotor_rate), "sigma_rotor_rate", "must be >= 0, got {}",
+        sigma_rotor_rate);
+  check(std::abs(rotor_delay_s) <= 1.0, "rotor_delay_s", "must be within [-1, 1] s, got {}", rotor_delay_s);
+  check(max_iterations >= 1, "max_iterations", "must be >= 1, got {}", max_iterations);
+  check(threads >= 1, "threads", "must be >= 1, got {}", threads);
+}
 
 std::vector<ThrustSample> ReadDidoCsv(const std::string& path) {
   static const std::vector<std::string_view> kHeader = {
@@ -273,7 +270,7 @@ double CollectiveFromAcceleration(const ThrustParameters& k, const Eigen::Vector
 
 ThrustEstimate EstimateThrust(const ThrustFlight& flight, const ThrustEstimateOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  Validate(options);
+  options.Validate();
   const ThrustParameters& k = flight.parameters;
   if (!(k.thrust_per_mass > 0) || !(k.gravity_mps2 > 0)) throw UsageError("the thrust coefficient and |g| must be > 0");
   const std::vector<ThrustSample>& samples = flight.samples;
@@ -337,9 +334,6 @@ ThrustEstimate EstimateThrust(const ThrustFlight& flight, const ThrustEstimateOp
   std::vector<double> breakpoints(segments + 1);
   for (int s = 0; s <= segments; ++s) breakpoints[s] = T * s / segments;
   using Problem = PseudoSpectralProblem<ThrustModel>;
-  // The attitude entries of every control are known inputs: held constant by this manifold, which
-  // must outlive the problem (the problem does not own it).
-  ceres::SubsetManifold hold_attitude(ThrustModel::kControlDim, {1, 2, 3, 4});
   Problem problem(ThrustModel{k}, breakpoints, options.degree);
   const double hover = k.HoverRotorSpeed();
   Eigen::Quaterniond previous = Eigen::Quaterniond::Identity();
@@ -369,7 +363,7 @@ ThrustEstimate EstimateThrust(const ThrustFlight& flight, const ThrustEstimateOp
       ++imu;
     }
   }
-  for (int g = 0; g < problem.num_nodes(); ++g) problem.ceres_problem().SetManifold(problem.Control(g), &hold_attitude);
+  problem.HoldControlEntries({1, 2, 3, 4});  // the attitude entries of every control are known inputs
 
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;

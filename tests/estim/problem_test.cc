@@ -1,10 +1,12 @@
-// The pseudo-spectral problem (estim/problem.h) on small models: every analytic Jacobian against
-// central differences on the manifold, the exact rotation-rate relation ω = J_r(φ) φ' (and that the
-// paper's ω = φ' is wrong away from the chart origin), and control recovery of the unicycle.
+// The pseudo-spectral problem (estim/problem.h) and its costs (estim/internal/*_cost.h) on small
+// models: every analytic Jacobian against central differences on the manifold, the exact
+// rotation-rate relation ω = J_r(φ) φ' (and that the paper's ω = φ' is wrong away from the chart
+// origin), the priors against closed forms, and control recovery of a unicycle.
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <functional>
+#include <limits>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -12,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <Eigen/Core>
 
+#include "cheval/cheb/chebyshev.h"
 #include "cheval/common/error.h"
 #include "cheval/estim/models.h"
 #include "cheval/estim/problem.h"
@@ -32,6 +35,26 @@ struct AttitudeModel {
       x_dot[i] = u[i];
       omega[i] = x[i];
     }
+  }
+};
+
+// A unicycle (planar car), a model without a rotation: vector state (4) = (x, y, θ, s) in blocks of
+// 2 — position (m), heading (rad), forward speed (m/s); control (2) = (forward acceleration m/s²,
+// yaw rate rad/s). x' = s cos θ, y' = s sin θ, θ' = u1, s' = u0.
+struct UnicycleModel {
+  static constexpr int kVectorDim = 4;
+  static constexpr int kBlockSize = 2;
+  static constexpr bool kHasRotation = false;
+  static constexpr int kControlDim = 2;
+
+  template <typename T>
+  void Dynamics(const T* x, const Eigen::Matrix<T, 3, 3>& /*R*/, const T* u, T* x_dot, T* /*omega*/) const {
+    using std::cos;
+    using std::sin;
+    x_dot[0] = x[3] * cos(x[2]);
+    x_dot[1] = x[3] * sin(x[2]);
+    x_dot[2] = u[1];
+    x_dot[3] = u[0];
   }
 };
 
@@ -370,6 +393,31 @@ double TotalCost(ceres::Problem& cp) {
   return cost;
 }
 
+// DerivativeMeasurementCost on a vector part that is a polynomial of the segment's degree: the
+// derivative row is exact, so h(x'(t)) = x'(t) − (the closed-form derivative) vanishes to rounding
+// (1e-12) at any t, and its Jacobian (w'_k per node, through the Jets) matches differences.
+struct RateResidual {
+  Eigen::Vector4d expected;
+  template <typename T>
+  bool operator()(const T* x_dot, T* r) const {
+    for (int i = 0; i < 4; ++i) r[i] = x_dot[i] - T(expected[i]);
+    return true;
+  }
+};
+
+TEST(PseudoSpectralProblem, DerivativeMeasurementIsExactOnPolynomials) {
+  PseudoSpectralProblem<UnicycleModel> problem(UnicycleModel{}, {0.0, 0.4, 1.1, 2.0}, 5);
+  const auto x = [](double t) { return Eigen::Vector4d(t * t * t, 2 - t, 0.5 * t * t, std::pow(t, 5)); };
+  const auto x_dot = [](double t) { return Eigen::Vector4d(3 * t * t, -1, t, 5 * std::pow(t, 4)); };
+  for (int g = 0; g < problem.num_nodes(); ++g) {
+    problem.SetNode(g, x(problem.NodeTime(g)), Eigen::Matrix3d::Identity(), Eigen::Vector2d::Zero());
+  }
+  for (double t : {0.0, 0.25, 0.4, 0.93, 2.0}) problem.AddDerivativeMeasurement(t, RateResidual{x_dot(t)}, 4);
+  EXPECT_LT(TotalCost(problem.ceres_problem()), 1e-20);
+  for (int g = 0; g < problem.num_nodes(); ++g) problem.Vector(g)[1] += 0.01 * g;  // off the polynomial
+  ExpectJacobianMatchesDifferences(problem);
+}
+
 // The prior is ∫ |u^(m)|² dt / σ² exactly (Ceres' cost is half of it), against closed forms; the
 // quadrature is exact, so the match is to rounding (1e-12 relative).
 TEST(PseudoSpectralProblem, ControlSmoothnessPriorIsTheExactIntegral) {
@@ -430,8 +478,9 @@ TEST(PseudoSpectralProblem, SmoothnessPriorSigmaPerSegment) {
 
 // In an orthonormal basis B of the controls (here a rotation by 30°) the prior is Σ_j ∫ |(Bᵀu)_j'|² /
 // σ_j²: ControlDerivativeEnergies splits ∫ |u'|² into the components' shares (they sum to the total),
-// and SetControlSmoothnessSigmas weights each; σ = ∞ drops a component. A basis that is not
-// orthonormal is rejected.
+// and SetControlSmoothnessSigmas weights each. A prior on some components only is a basis of fewer
+// columns (here the first: the second component is not in the prior at all). A basis that is not
+// orthonormal and a σ that is not finite are rejected.
 TEST(PseudoSpectralProblem, SmoothnessPriorPerComponentOfABasis) {
   const double sigma = 0.7, c = std::cos(M_PI / 6), s30 = std::sin(M_PI / 6);
   Eigen::Matrix2d B;
@@ -450,12 +499,74 @@ TEST(PseudoSpectralProblem, SmoothnessPriorPerComponentOfABasis) {
     total += parts.back().sum();
   }
   EXPECT_NEAR(TotalCost(problem.ceres_problem()), 0.5 * total / (sigma * sigma), 1e-12 * total);
-  problem.SetControlSmoothnessSigmas(1, 1, Eigen::Vector2d(2 * sigma, std::numeric_limits<double>::infinity()));
-  const double want = 0.5 * (parts[0].sum() + parts[2].sum() + parts[1][0] / 4) / (sigma * sigma);
+  problem.SetControlSmoothnessSigmas(1, 1, Eigen::Vector2d(2 * sigma, 0.5 * sigma));
+  const double want = 0.5 * (parts[0].sum() + parts[2].sum() + parts[1][0] / 4 + 4 * parts[1][1]) / (sigma * sigma);
   EXPECT_NEAR(TotalCost(problem.ceres_problem()), want, 1e-12 * want);
   ExpectJacobianMatchesDifferences(problem);
-  EXPECT_THROW(problem.AddControlSmoothnessPrior(1, sigma, Eigen::Matrix2d::Constant(1.0)), UsageError);
+  EXPECT_THROW(problem.SetControlSmoothnessSigmas(1, 1, Eigen::Vector2d(sigma, std::numeric_limits<double>::infinity())),
+               UsageError);
+  EXPECT_THROW(problem.AddControlSmoothnessPrior(1, sigma, B), UsageError);  // one prior per order
   EXPECT_THROW(problem.SetControlSmoothnessSigmas(2, 0, Eigen::Vector2d(1, 1)), UsageError);  // no order-2 prior
+  // Only the first component: its energy alone; removing the prior leaves no cost.
+  problem.RemoveControlSmoothnessPrior(1);
+  EXPECT_EQ(TotalCost(problem.ceres_problem()), 0.0);
+  problem.AddControlSmoothnessPrior(1, sigma, B.leftCols<1>());
+  const double first = parts[0][0] + parts[1][0] + parts[2][0];
+  EXPECT_NEAR(TotalCost(problem.ceres_problem()), 0.5 * first / (sigma * sigma), 1e-12 * first);
+  ExpectJacobianMatchesDifferences(problem);
+  problem.RemoveControlSmoothnessPrior(1);
+  EXPECT_THROW(problem.RemoveControlSmoothnessPrior(1), UsageError);
+  EXPECT_THROW(problem.AddControlSmoothnessPrior(1, sigma, Eigen::Matrix2d::Constant(1.0)), UsageError);
+}
+
+// ControlRateCost on controls linear in t, u = a t + b: D U is exact, so every node's residual is
+// sqrt(Δt) a / σ and a segment's N + 1 residuals sum to L a² / σ² per entry (Δt = L / (N + 1)): the
+// whole cost is ½ T |a|² / σ², to rounding. Jacobians against differences; σ <= 0 rejected.
+TEST(PseudoSpectralProblem, ControlRatePriorOnALinearControl) {
+  PseudoSpectralProblem<UnicycleModel> problem(UnicycleModel{}, {0.0, 0.4, 1.1, 2.0}, 5);
+  const Eigen::Vector2d a(1.5, -0.4), b(0.2, 3.0);
+  for (int g = 0; g < problem.num_nodes(); ++g) {
+    problem.SetNode(g, Eigen::Vector4d::Zero(), Eigen::Matrix3d::Identity(), a * problem.NodeTime(g) + b);
+  }
+  const double sigma = 0.3;
+  problem.AddControlRatePrior(sigma);
+  const double want = 0.5 * 2.0 * a.squaredNorm() / (sigma * sigma);
+  EXPECT_NEAR(TotalCost(problem.ceres_problem()), want, 1e-12 * want);
+  ExpectJacobianMatchesDifferences(problem);
+  EXPECT_THROW(problem.AddControlRatePrior(0.0), UsageError);
+}
+
+// AddPrior takes any cost on the problem's blocks and RemovePrior takes it out again: a rate prior
+// built by hand for one node adds exactly its own ½ |r|², and removing it restores the cost.
+TEST(PseudoSpectralProblem, PriorsComeAndGoThroughOneInterface) {
+  auto problem = PolynomialControls(1, 0.7);
+  const double before = TotalCost(problem.ceres_problem());
+  const Eigen::MatrixXd D = cheb::DifferentiationMatrix(problem.degree());
+  auto cost = std::make_unique<internal::ControlRateCost<2>>(problem.SegmentOf(1), 0.7, D, 2, 0.5);
+  Eigen::Vector2d r;
+  std::vector<double*> blocks = cost->blocks();
+  ASSERT_TRUE(cost->Evaluate(blocks.data(), r.data(), nullptr));
+  const PriorId id = problem.AddPrior(std::move(cost));
+  EXPECT_NEAR(TotalCost(problem.ceres_problem()), before + 0.5 * r.squaredNorm(), 1e-12 * before);
+  problem.RemovePrior(id);
+  EXPECT_NEAR(TotalCost(problem.ceres_problem()), before, 1e-14 * before);
+}
+
+// HoldControlEntries holds the given control entries constant: the control blocks' tangent keeps
+// only the others, and a solve moves only those.
+TEST(PseudoSpectralProblem, HeldControlEntriesStayConstant) {
+  auto problem = PolynomialControls(1, 0.7);
+  std::vector<double> held;
+  for (int g = 0; g < problem.num_nodes(); ++g) held.push_back(problem.Control(g)[1]);
+  problem.HoldControlEntries({1});
+  EXPECT_EQ(problem.ceres_problem().ParameterBlockTangentSize(problem.Control(0)), 1);
+  ceres::Solver::Options options;
+  options.max_num_iterations = 5;
+  problem.Solve(options);
+  for (int g = 0; g < problem.num_nodes(); ++g) EXPECT_EQ(problem.Control(g)[1], held[g]) << g;
+  // u0 becomes constant (its rate energy goes); u1 = 0.5 t² + 1 keeps ∫_0^2 t² dt = 8/3.
+  const double want = 0.5 * (8.0 / 3.0) / (0.7 * 0.7);
+  EXPECT_NEAR(TotalCost(problem.ceres_problem()), want, 1e-9 * want);
 }
 
 }  // namespace

@@ -5,16 +5,18 @@
 #include <random>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "cheval/common/error.h"
+#include "cheval/estim/internal/thrust_acceleration_cost.h"
 #include "cheval/estim/models.h"
+#include "cheval/estim/problem.h"
 #include "cheval/estim/quadrotor_data.h"
 #include "cheval/estim/quadrotor_estimator.h"
 #include "cheval/estim/quadrotor_scoring.h"
-#include "cheval/estim/thrust_vector_prior.h"
 #include "cheval/estim/vehicle.h"
 #include "cheval/lie/so3.h"
 #include "cheval/sim/quadrotor.h"
@@ -28,7 +30,7 @@ const std::string kVehicle = std::string(CHEVAL_SOURCE_DIR) + "/data/vehicles/fl
 
 TEST(QuadrotorModel, ShippedVehicleHoversAtTheDocumentedSpeed) {
   const estim::Vehicle v = estim::ReadVehicle(kVehicle);
-  // ESTIMATOR.md: sqrt(m g / 4 k_F) ≈ 1133 rad/s for the FlightGoggles vehicle.
+  // docs/estimator.md: sqrt(m g / 4 k_F) ≈ 1133 rad/s for the FlightGoggles vehicle.
   EXPECT_NEAR(v.quadrotor.HoverRotorSpeed(), std::sqrt(1.0 * 9.81 / (4 * 1.91e-6)), 1e-9);
   EXPECT_NEAR(v.quadrotor.HoverRotorSpeed(), 1133.1, 0.1);
   const estim::QuadrotorModel model{v.quadrotor};
@@ -39,7 +41,7 @@ TEST(QuadrotorModel, ShippedVehicleHoversAtTheDocumentedSpeed) {
   for (int i = 0; i < 9; ++i) EXPECT_NEAR(x_dot[i], 0.0, 1e-12) << i;
 }
 
-// Motor layout of ESTIMATOR.md: speeding up the two left motors (0, 1; y = +a) rolls right-side
+// Motor layout of docs/estimator.md: speeding up the two left motors (0, 1; y = +a) rolls right-side
 // down (τ_x > 0); the front ones (0, 3; x = +a) pitch nose up (τ_y < 0); the +1-spin motors (1, 3)
 // yaw positive.
 TEST(QuadrotorModel, TorquesFollowTheMotorLayout) {
@@ -155,12 +157,14 @@ Flight FourSecondFlight(const estim::Vehicle& v, sim::QuadrotorScenario scenario
   return flight;
 }
 
-// End to end on a short hover and a short figure-eight with the defaults: the rotor speeds come back
-// to well within 1 % (the 10 s runs of docs/estimator.md measure at most 0.47 %; 4 s flights have
-// relatively more interval ends, so the bound here is 1 %), poses to a centimetre.
+// End to end on a short hover and a short figure-eight (seed 1) with the defaults. Measured: worst
+// motor 0.066 % / 0.135 %, position RMSE 1.9 / 2.6 mm, rotation RMSE 0.029° / 0.030°. The flights
+// are deterministic (seeded simulator, one thread), so the bounds sit at ~1.5x those figures: room
+// for rounding across compilers and Ceres versions, not for a regression of the estimator.
 TEST(QuadrotorEstimator, RecoversRotorSpeedsFromTheCamera) {
   const estim::Vehicle v = estim::ReadVehicle(kVehicle);
   for (sim::QuadrotorScenario scenario : {sim::QuadrotorScenario::kHover, sim::QuadrotorScenario::kFigureEight}) {
+    const bool hover = scenario == sim::QuadrotorScenario::kHover;
     const Flight flight = FourSecondFlight(v, scenario);
     const estim::QuadrotorData& data = flight.data;
     const std::vector<double>& times = flight.times;
@@ -170,9 +174,9 @@ TEST(QuadrotorEstimator, RecoversRotorSpeedsFromTheCamera) {
     EXPECT_EQ(e.states, e.segments * e.degree + 1);
     const estim::QuadrotorErrors errors = estim::CompareWithTruth(e, data.truth);
     EXPECT_EQ(errors.samples, 401);
-    EXPECT_LT(errors.rotor_error_percent.maxCoeff(), 1.0) << sim::ToString(scenario);
-    EXPECT_LT(errors.position_rmse_m, 0.01);
-    EXPECT_LT(errors.rotation_rmse_deg, 0.1);
+    EXPECT_LT(errors.rotor_error_percent.maxCoeff(), hover ? 0.1 : 0.2) << sim::ToString(scenario);
+    EXPECT_LT(errors.position_rmse_m, hover ? 0.003 : 0.004);
+    EXPECT_LT(errors.rotation_rmse_deg, 0.045);
     // The front end's initial poses were worse than the estimate.
     double initial_p2 = 0;
     for (size_t i = 0; i < data.initial.size(); ++i) {
@@ -259,85 +263,72 @@ TEST(QuadrotorEstimator, AdaptiveRotorPriorSigmaIsTheRandomWalkMaximumLikelihood
   EXPECT_NEAR(mean, sigma, 0.02 * sigma);
 }
 
-// End to end: the adaptive prior (the default) against one σ_u = 100 everywhere on a 4 s hover and
-// a 4 s aggressive flight (seed 1). Hover: the truth's rotor speeds are constant, so the pilot's
-// rotor rate is noise and σ drops to the floor; the collective's thrust-acceleration prior
-// (thrust_prior, the default) gives 0.066 % against 0.434 % (bound: half); aggressive: 0.512 %
-// against 0.939 % (bound: better), and 0.945 % with the collective's random-walk prior instead
-// (thrust_prior = false; bound: better). (Figures of the defaults, degree 4 on 0.2 s.) Iterations:
-// 3 in all (one pilot iteration plus two of the final solve, as the fixed σ_u's 3) except the short
-// aggressive flight with the thrust prior, 4 (bound: three times; the 10 s flights of
-// docs/estimator.md take 3).
-TEST(QuadrotorEstimator, AdaptiveRotorPriorBeatsOneFixedSigma) {
+// End to end: the collective's thrust-acceleration prior (thrust_prior, the default) against the
+// random-walk prior on the collective (thrust_prior = false) on a 4 s hover and a 4 s aggressive
+// flight (seed 1). Measured, worst motor: hover 0.066 % against 0.122 %, aggressive 0.512 % against
+// 0.945 %, so the thrust prior's error is 0.54x the random walk's on both; 3 and 4 iterations (the
+// random walk 3 on both). Deterministic runs: bounds ~1.5x the figures (0.1 %, 0.75 %), the ratio
+// at 0.6 and the iterations at the measured counts + 1.
+TEST(QuadrotorEstimator, ThrustPriorBeatsTheRandomWalkCollective) {
   const estim::Vehicle v = estim::ReadVehicle(kVehicle);
   for (sim::QuadrotorScenario scenario : {sim::QuadrotorScenario::kHover, sim::QuadrotorScenario::kAggressive}) {
     const Flight flight = FourSecondFlight(v, scenario);
     const estim::QuadrotorData& data = flight.data;
     const std::vector<double>& times = flight.times;
-    estim::QuadrotorEstimateOptions fixed, random_walk;
-    fixed.adaptive_rotor_prior = false;
+    estim::QuadrotorEstimateOptions random_walk;
     random_walk.thrust_prior = false;
     const estim::QuadrotorEstimate a = estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, {}, times);
-    const estim::QuadrotorEstimate f = estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, fixed, times);
     const estim::QuadrotorEstimate r =
         estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, random_walk, times);
     EXPECT_TRUE(a.converged) << a.solver_report;
-    const double adaptive_error = estim::CompareWithTruth(a, data.truth).rotor_error_percent.maxCoeff();
-    const double fixed_error = estim::CompareWithTruth(f, data.truth).rotor_error_percent.maxCoeff();
+    EXPECT_TRUE(r.converged) << r.solver_report;
+    const double thrust_error = estim::CompareWithTruth(a, data.truth).rotor_error_percent.maxCoeff();
     const double random_walk_error = estim::CompareWithTruth(r, data.truth).rotor_error_percent.maxCoeff();
-    if (scenario == sim::QuadrotorScenario::kHover) {
-      EXPECT_LT(adaptive_error, 0.5 * fixed_error);
-    } else {
-      EXPECT_LT(adaptive_error, fixed_error);
-      EXPECT_LT(adaptive_error, random_walk_error);
-    }
-    EXPECT_LE(a.iterations, 3 * f.iterations);
-    EXPECT_LE(r.iterations, f.iterations + 1);
+    const bool hover = scenario == sim::QuadrotorScenario::kHover;
+    EXPECT_LT(thrust_error, hover ? 0.1 : 0.75);
+    EXPECT_LT(thrust_error, 0.6 * random_walk_error);
+    EXPECT_LE(a.iterations, hover ? 4 : 5);
+    EXPECT_LE(r.iterations, 4);
   }
-  estim::QuadrotorEstimateOptions bad;
-  bad.pilot_iterations = 0;
+}
+
+// Every option is validated before any work, and the error names the struct and the field (the
+// faces translate the field into their flag or keyword).
+TEST(QuadrotorEstimator, BadOptionsNameTheField) {
+  const estim::Vehicle v = estim::ReadVehicle(kVehicle);
   sim::QuadrotorSimOptions options;
   options.duration_s = 1.0;
   const estim::QuadrotorData data = sim::SimulateQuadrotor(v, options);
-  EXPECT_THROW(estim::EstimateQuadrotor(v, data.landmarks, data.pixels, data.initial, bad, {}), UsageError);
+  const auto message = [&](const estim::QuadrotorEstimateOptions& bad) -> std::string {
+    try {
+      estim::EstimateQuadrotor(v, data.landmarks, data.pixels, data.initial, bad, {});
+    } catch (const OptionError& e) {
+      EXPECT_EQ(e.options(), "QuadrotorEstimateOptions");
+      return e.what();
+    }
+    return "no error";
+  };
+  estim::QuadrotorEstimateOptions bad;
+  bad.degree = 1;
+  EXPECT_EQ(message(bad), "QuadrotorEstimateOptions::degree must be in [2, 64], got 1");
+  bad = {};
+  bad.pilot_iterations = 0;
+  EXPECT_EQ(message(bad), "QuadrotorEstimateOptions::pilot_iterations must be >= 1, got 0");
   bad = {};
   bad.adaptive_rotor_prior_floor = 0;
-  EXPECT_THROW(estim::EstimateQuadrotor(v, data.landmarks, data.pixels, data.initial, bad, {}), UsageError);
-}
-
-// The variants of the collective's prior that docs/estimator.md ("What was tried") measured and did
-// not make the default: a second empirical-Bayes round (thrust_prior_rounds = 2), a Matérn-5/2
-// process (thrust_prior_order = 3) and the Matérn-3/2 prior on the kinematic acceleration v'
-// (motion_prior). On the 4 s aggressive flight (seed 1) all converge to within 0.1 percentage points
-// of the default's error (0.557 / 0.460 / 0.474 % against 0.512 %); bad values are UsageErrors.
-TEST(QuadrotorEstimator, ThrustPriorVariantsRunAndValidate) {
-  const estim::Vehicle v = estim::ReadVehicle(kVehicle);
-  const Flight flight = FourSecondFlight(v, sim::QuadrotorScenario::kAggressive);
-  const estim::QuadrotorData& data = flight.data;
-  const estim::QuadrotorEstimate d = estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, {}, flight.times);
-  const double default_error = estim::CompareWithTruth(d, data.truth).rotor_error_percent.maxCoeff();
-  for (int variant = 0; variant < 3; ++variant) {
-    estim::QuadrotorEstimateOptions o;
-    if (variant == 0) o.thrust_prior_rounds = 2;
-    if (variant == 1) o.thrust_prior_order = 3;
-    if (variant == 2) o.motion_prior = true;
-    const estim::QuadrotorEstimate e = estim::EstimateQuadrotor(data.vehicle, data.landmarks, data.pixels, data.initial, o, flight.times);
-    EXPECT_TRUE(e.converged) << variant << ": " << e.solver_report;
-    const double error = estim::CompareWithTruth(e, data.truth).rotor_error_percent.maxCoeff();
-    std::printf("variant %d: %.3f %% (default %.3f %%), %d iterations\n", variant, error, default_error, e.iterations);
-    EXPECT_LT(std::abs(error - default_error), 0.1) << variant;
-  }
-  estim::QuadrotorEstimateOptions bad;
-  bad.thrust_prior_rounds = 0;
-  EXPECT_THROW(estim::EstimateQuadrotor(v, data.landmarks, data.pixels, data.initial, bad, {}), UsageError);
+  EXPECT_EQ(message(bad), "QuadrotorEstimateOptions::adaptive_rotor_prior_floor must be > 0, got 0");
   bad = {};
-  bad.thrust_prior_order = 4;
-  EXPECT_THROW(estim::EstimateQuadrotor(v, data.landmarks, data.pixels, data.initial, bad, {}), UsageError);
+  bad.sigma_rotor_rate = 0;
+  EXPECT_EQ(message(bad), "QuadrotorEstimateOptions::sigma_rotor_rate must be > 0, got 0");
+  bad = {};
+  bad.segment_s = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(message(bad), "QuadrotorEstimateOptions::segment_s must be a positive number of seconds, got inf");
+  EXPECT_NO_THROW(estim::QuadrotorEstimateOptions{}.Validate());
 }
 
 // The thrust-acceleration rows against a direct evaluation and central differences in the blocks'
 // ambient coordinates (rotor speeds, quaternion x, y, z, w): f_k = (k_F/m) |Ω_k|² R_k e3.
-TEST(QuadrotorEstimator, ThrustVectorPriorJacobiansMatchDifferences) {
+TEST(QuadrotorEstimator, ThrustAccelerationCostJacobiansMatchDifferences) {
   const estim::Vehicle v = estim::ReadVehicle(kVehicle);
   using Problem = estim::PseudoSpectralProblem<estim::QuadrotorModel>;
   Problem problem(estim::QuadrotorModel{v.quadrotor}, {0.0, 0.7}, 4);
@@ -351,8 +342,8 @@ TEST(QuadrotorEstimator, ThrustVectorPriorJacobiansMatchDifferences) {
   const double k_over_m = v.quadrotor.thrust_coefficient / v.quadrotor.mass_kg;
   std::array<Eigen::MatrixXd, 3> C{Eigen::MatrixXd::Random(2, 5), Eigen::MatrixXd::Random(2, 5), Eigen::MatrixXd::Random(2, 5)};
   const Eigen::MatrixXd offsets = Eigen::MatrixXd::Random(2, 3);
-  std::vector<int> nodes{0, 1, 2, 3, 4};
-  estim::ThrustVectorSmoothnessCost cost(problem, nodes, C, offsets, k_over_m);
+  const estim::internal::Segment segment = problem.SegmentOf(0);
+  estim::internal::ThrustAccelerationCost cost(segment.control, segment.quaternion, C, offsets, k_over_m);
   cost.set_weight(0.3);
   std::vector<double*> blocks = cost.blocks();
   const auto residuals = [&]() {
@@ -365,8 +356,9 @@ TEST(QuadrotorEstimator, ThrustVectorPriorJacobiansMatchDifferences) {
     for (int a = 0; a < 3; ++a) {
       double sum = offsets(row, a);
       for (int k = 0; k < 5; ++k) {
-        const Eigen::Map<const Eigen::Vector4d> u(problem.Control(k));
-        const Eigen::Matrix3d R = Eigen::Quaterniond(Eigen::Map<const Eigen::Vector4d>(problem.Quaternion(k))).toRotationMatrix();
+        const int g = problem.NodeOf(0, k);  // C's column k is point k of the segment
+        const Eigen::Map<const Eigen::Vector4d> u(problem.Control(g));
+        const Eigen::Matrix3d R = Eigen::Quaterniond(Eigen::Map<const Eigen::Vector4d>(problem.Quaternion(g))).toRotationMatrix();
         sum += C[a](row, k) * k_over_m * u.squaredNorm() * R(a, 2);
       }
       want[3 * row + a] = 0.3 * sum;

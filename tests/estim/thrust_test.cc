@@ -136,7 +136,12 @@ TEST(ThrustEstimator, RejectsBadOptions) {
   const estim::ThrustFlight flight = SimulatedFlight(sim::QuadrotorScenario::kHover, 1.0);
   estim::ThrustEstimateOptions o;
   o.degree = 1;
-  EXPECT_THROW(estim::EstimateThrust(flight, o), UsageError);
+  try {
+    estim::EstimateThrust(flight, o);
+    ADD_FAILURE() << "no error";
+  } catch (const OptionError& e) {  // the field, not a flag: the CLI translates it
+    EXPECT_EQ(std::string(e.what()), "ThrustEstimateOptions::degree must be in [2, 64], got 1");
+  }
   o = {};
   o.position_sigma_m = 0;
   EXPECT_THROW(estim::EstimateThrust(flight, o), UsageError);
@@ -219,7 +224,7 @@ TEST_F(DidoReader, ParametersInSiUnits) {
   // kf is per (1e4 rpm)²: 1e4 rpm = 1e4 π/30 rad/s.
   const double unit = 1e4 * std::numbers::pi / 30;
   EXPECT_NEAR(d.parameters.thrust_per_mass, 1.12640015 / (unit * unit), 1e-20);
-  EXPECT_NEAR(d.parameters.thrust_per_mass, 1.027e-6, 1e-9);  // SOURCE.md: ≈ 1.03e-6 (m/s²)/(rad/s)²
+  EXPECT_NEAR(d.parameters.thrust_per_mass, 1.027e-6, 1e-9);  // docs/estimator_real_data.md: 1.027e-6 (m/s²)/(rad/s)²
   EXPECT_NEAR(d.parameters.rotor_drag.z(), -0.04 / unit, 1e-15);
   EXPECT_DOUBLE_EQ(d.parameters.gravity_mps2, 9.8);
   EXPECT_EQ(d.t_imu_thrust, Eigen::Vector3d(0.01, 0.02, -0.04));
@@ -240,7 +245,7 @@ TEST_F(DidoReader, ParametersInSiUnits) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The real DIDO flights (../shared/data/dido/csv, SOURCE.md). The positions are the mocap spline, so
+// The real DIDO flights (../shared/data/dido/csv, docs/estimator_real_data.md). The positions are the mocap spline, so
 // without added noise the estimator can do no better than the model itself: the bound is the oracle
 // (Ω_c from the spline's true acceleration through the same model) + 10 %. Measured (this build):
 // circle estimator 0.294 % / oracle 0.296 %, eight 0.428 % / 0.419 %; with 5 mm noise and the IMU

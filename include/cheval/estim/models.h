@@ -19,7 +19,7 @@
 
 namespace cheval::estim {
 
-/// Physical parameters of an X-configuration quadrotor (ESTIMATOR.md; docs/estimator.md). SI units.
+/// Physical parameters of an X-configuration quadrotor (docs/estimator.md, "The quadrotor"). SI units.
 /// Motors (FlightGoggles convention, numbered counter-clockwise seen from above, 0 = front-left):
 /// 0 at (+a, +a) spin −1; 1 at (−a, +a) spin +1; 2 at (−a, −a) spin −1; 3 at (+a, −a) spin +1 (body
 /// x forward, y left, z up).
@@ -38,10 +38,10 @@ struct QuadrotorParameters {
   double HoverRotorSpeed() const { return std::sqrt(mass_kg * gravity_mps2 / (4.0 * thrust_coefficient)); }
 };
 
-/// The quadrotor of ESTIMATOR.md as an estimator model. Vector state (9): p (world, m), v (world,
+/// The quadrotor of docs/estimator.md as an estimator model. Vector state (9): p (world, m), v (world,
 /// m/s), ω (body, rad/s) in blocks of 3; rotation R_world_body; control (4): rotor speeds Ω_i (rad/s).
-/// p' = v; R' = R[ω]×; v' = g + (k_F Σ Ω_i² / m) R e3 − (c/m)|v| v; ω' = J⁻¹(τ − ω × Jω), τ as
-/// ESTIMATOR.md (rotor speeds are taken as the true speeds: the motor lag is not part of f).
+/// p' = v; R' = R[ω]×; v' = g + (k_F Σ Ω_i² / m) R e3 − (c/m)|v| v; ω' = J⁻¹(τ − ω × Jω), τ as in
+/// Torque below (rotor speeds are taken as the true speeds: the motor lag is not part of f).
 struct QuadrotorModel {
   static constexpr int kVectorDim = 9;
   static constexpr int kBlockSize = 3;
@@ -89,26 +89,6 @@ struct QuadrotorModel {
       x_dot[6 + i] = w_dot[i];
       omega[i] = w[i];
     }
-  }
-};
-
-/// A unicycle (planar car), the second model: vector state (4) = (x, y, θ, s) in blocks of 2 —
-/// position (m), heading (rad), forward speed (m/s); no SO(3) rotation; control (2) = (forward
-/// acceleration m/s², yaw rate rad/s). x' = s cos θ, y' = s sin θ, θ' = u1, s' = u0.
-struct UnicycleModel {
-  static constexpr int kVectorDim = 4;
-  static constexpr int kBlockSize = 2;
-  static constexpr bool kHasRotation = false;
-  static constexpr int kControlDim = 2;
-
-  template <typename T>
-  void Dynamics(const T* x, const Eigen::Matrix<T, 3, 3>& /*R*/, const T* u, T* x_dot, T* /*omega*/) const {
-    using std::cos;
-    using std::sin;
-    x_dot[0] = x[3] * cos(x[2]);
-    x_dot[1] = x[3] * sin(x[2]);
-    x_dot[2] = u[1];
-    x_dot[3] = u[0];
   }
 };
 

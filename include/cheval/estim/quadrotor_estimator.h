@@ -31,67 +31,46 @@ struct PoseSample {
   Eigen::Quaterniond q;
 };
 
-/// Defaults chosen once for every scenario (docs/estimator.md explains them).
+/// The estimator's options, one default set for every scenario (docs/estimator.md, "The algorithm", says
+/// why each is what it is). The estimator runs: a pilot solve with the rotor prior at
+/// sigma_rotor_rate everywhere → σ of the rotor prior per segment from the pilot (empirical Bayes) →
+/// the solve to convergence.
 struct QuadrotorEstimateOptions {
-  /// --degree: polynomial degree per segment (>= 2). --segment: segment length, s (> 0); the flight
-  /// is cut into round(T / segment_s) segments. Short, low-degree segments because the priors' σ are
-  /// estimated per segment: 0.2 s resolves where the thrust changes fast (docs/estimator.md,
-  /// "Segments").
+  /// Polynomial degree per segment, in [2, 64].
   int degree = 4;
+  /// Segment length, s (> 0): the flight is cut into round(T / segment_s) segments. Short segments
+  /// because the priors' σ are estimated per segment.
   double segment_s = 0.2;
-  /// σ of the collocation defects: p' (m/s), v' (m/s²), ω' (rad/s²), body rate of R (rad/s).
+  /// σ of the collocation defects (> 0): p' (m/s), v' (m/s²), ω' (rad/s²), body rate of R (rad/s).
   double sigma_position_rate = 1e-3, sigma_acceleration = 1e-2, sigma_angular_acceleration = 1e-1,
          sigma_rotation_rate = 1e-3;
-  /// σ of the rotor-speed smoothness prior ∫ |Ω^(m)|² dt / σ² (AddControlSmoothnessPrior, exact per
-  /// segment), rad/s per s^m per s^(1/2); 0 = none.
+  /// σ of the pilot's rotor-speed prior ∫ |Ω'|² dt / σ² on every segment, rad/s² per s^(1/2) (> 0).
   double sigma_rotor_rate = 100.0;
-  /// m of that prior: 1 = white noise on the rotor rate Ω' (Ω a random walk), 2 = on Ω'' (1..3).
-  int rotor_prior_order = 1;
-  /// Empirical Bayes for that prior's σ per segment (order 1 only; docs/estimator.md): a pilot solve
-  /// of `pilot_iterations` Levenberg–Marquardt iterations with sigma_rotor_rate everywhere, then
-  /// σ_s = max(floor, AdaptiveRotorPriorSigma), the maximum-likelihood random-walk intensity of the
-  /// pilot's rotor speeds over segments s − 1..s + 1, and the solve to convergence. false: one solve
-  /// with sigma_rotor_rate everywhere.
-  bool adaptive_rotor_prior = true;
-  int pilot_iterations = 1;                ///< Levenberg–Marquardt iterations of the pilot solve (>= 1)
-  double adaptive_rotor_prior_floor = 30;  ///< lower bound of the per-segment σ, rad/s² per s^(1/2) (> 0)
-  /// The collective rotor speed's prior on the world-frame thrust acceleration instead
-  /// (docs/estimator.md, "Defaults"; needs adaptive_rotor_prior): after the pilot, the collective
-  /// component of the rotor-rate prior is dropped and a = f − ḡ, f = (k_F ΣΩ²/m) R e3, ḡ the hover
-  /// thrust, gets ∫ |(D + λ_a)² a_a|² dt / σ_s² per axis a (a Matérn-3/2 process: a stationary
-  /// acceleration of correlation time 1/λ_a) with λ_a the root-mean-square frequency of the pilot's
-  /// a_a (sqrt(−∫a''a / ∫a²), at most thrust_prior_max_rate rad/s), σ_s the maximum-likelihood
-  /// intensity of segment s alone, f' continuous at the breakpoints, and the stationary law of
-  /// (a, a') at the first time (the exact density of the stationary process). The differential
-  /// (roll, pitch, yaw) components keep the random-walk prior with the per-segment σ above.
+  /// Levenberg–Marquardt iterations of the pilot solve (>= 1).
+  int pilot_iterations = 1;
+  /// Lower bound of the per-segment σ of the rotor prior after the pilot, σ_s = max(floor,
+  /// AdaptiveRotorPriorSigma), rad/s² per s^(1/2) (> 0).
+  double adaptive_rotor_prior_floor = 30;
+  /// After the pilot, the collective rotor speed's prior is the Matérn-3/2 prior on the world-frame
+  /// thrust acceleration (docs/estimator.md, "The algorithm", step 5); the differential (roll,
+  /// pitch, yaw) components keep the rotor prior. false: the collective keeps the rotor prior too.
   bool thrust_prior = true;
-  double thrust_prior_max_rate = 6.0;  ///< rad/s (> 0): the bound of λ_a on an axis without motion
-  /// Empirical-Bayes rounds of the thrust prior (>= 1): after each solve with it, λ_a and σ_s are
-  /// re-estimated from that solution and the problem is solved again (1: from the pilot only).
-  /// These three options are measured variants, not the defaults (docs/estimator.md, "Closing the
-  /// last two aggressive seeds": none gets the aggressive flight under 0.5 % on every seed).
-  int thrust_prior_rounds = 1;
-  /// Order m of the thrust prior (2 or 3; motion_prior too): ∫ |(D + λ_a)^m a_a|² dt, 2 a
-  /// Matérn-3/2 process, 3 a Matérn-5/2 one (λ_a = √3 × the rms frequency, f'' continuous as well, its stationary law of
-  /// (a, a', a'') at the first time).
-  int thrust_prior_order = 2;
-  /// The Matérn-3/2 prior of thrust_prior on the kinematic acceleration v' (a motion prior; the
-  /// collective follows through the collocation of v' = f − g − drag) instead of on f − ḡ.
-  bool motion_prior = false;
-  double huber_pixels = 3.0;  ///< Huber threshold on each landmark's whitened pixel error (in σ)
+  double thrust_prior_max_rate = 6.0;  ///< rad/s (> 0): the bound of the thrust prior's λ_a
+  double huber_pixels = 3.0;  ///< Huber threshold on each landmark's whitened pixel error, in σ (> 0)
   /// Window of the flatness-based initialisation (FlatnessInitialState), s (> 0).
   double initial_window_s = 0.6;
-  /// Levenberg–Marquardt's initial trust-region radius (1/λ₀; Ceres' default is 1e4). The problem is
-  /// nearly linear from the flatness-based start, so a near Gauss–Newton first step is accepted:
-  /// 3–4 iterations instead of 6–7, the same minimum (docs/estimator.md).
+  /// Levenberg–Marquardt's initial trust-region radius (> 0; Ceres' default is 1e4): the problem is
+  /// nearly linear from the flatness-based start, so a near Gauss–Newton first step is accepted.
   double initial_trust_region_radius = 1e8;
-  int max_iterations = 50;
-  /// Ceres' convergence tolerances (its defaults): relative cost change, gradient, step. Tighter
-  /// ones change nothing (the solve is converged: docs/estimator.md).
+  int max_iterations = 50;  ///< of the final solve (>= 1)
+  /// Ceres' convergence tolerances (its defaults; > 0): relative cost change, gradient, step.
   double function_tolerance = 1e-6, gradient_tolerance = 1e-10, parameter_tolerance = 1e-8;
-  int threads = 1;
+  int threads = 1;  ///< >= 1
   /// Told "solver iterations" with the iterations done so far (total unknown: 0), after each one.
   ProgressFn progress;
+
+  /// Throws OptionError naming the first field out of its range (above).
+  void Validate() const;
 };
 
 /// The estimate at one time.
@@ -123,7 +102,7 @@ struct QuadrotorEstimate {
 /// body rate ω is the slope of a linear fit of Log(R⁻¹ R_i) over the same window; the collective
 /// thrust is T = (m (a − g) + c |v| v) · R e3 and the torques τ = ω × Jω (ω' is taken as 0: the
 /// front end's attitude noise makes its second derivative useless); the rotor speeds invert the
-/// mixer of ESTIMATOR.md exactly, sqrt(max(f_i, 0) / k_F), capped at the rotor limit. Nothing but
+/// mixer of models.h exactly, sqrt(max(f_i, 0) / k_F), capped at the rotor limit. Nothing but
 /// the poses and the vehicle file is used. Throws ComputeError with fewer than 3 poses.
 QuadrotorStateEstimate FlatnessInitialState(const QuadrotorParameters& vehicle, const std::vector<PoseSample>& poses,
                                             double t, double window_s);
@@ -138,7 +117,7 @@ QuadrotorStateEstimate FlatnessInitialState(const QuadrotorParameters& vehicle, 
 std::vector<double> AdaptiveRotorPriorSigma(const std::vector<double>& energy, int degree, int controls);
 
 /// Estimates the flight over [first, last] measurement time and returns it at `query_times` (those
-/// outside the interval are skipped). Throws UsageError for bad options, ComputeError when there are
+/// outside the interval are skipped). Throws OptionError for bad options, ComputeError when there are
 /// fewer than 2 frame times or 3 initial poses, a landmark id is out of range, the initial poses do
 /// not cover the measurement interval, or a measurement falls outside the estimated interval.
 QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Eigen::Vector3d>& landmarks,

@@ -2,8 +2,8 @@
 /// \file
 /// The collective rotor speed of a quadrotor from positions (and optionally an accelerometer), its
 /// measured attitude and the translational dynamics of thrust_model.h, on the pseudo-spectral problem
-/// (problem.h). Written for the real DIDO flights (../shared/data/dido, SOURCE.md; results in
-/// docs/estimator_real_data.md), also fed from the simulator (sim/quadrotor.h) for tests.
+/// (problem.h). Written for the real DIDO flights (docs/estimator_real_data.md has the data, the
+/// formats and the results), also fed from the simulator (sim/quadrotor.h) for tests.
 
 #include <cstdint>
 #include <string>
@@ -41,14 +41,14 @@ struct ThrustFlight {
 };
 
 /// Reads a DIDO sequence CSV (header t_s,p_x,p_y,p_z,q_w,q_x,q_y,q_z,v_x,v_y,v_z,gt_gyr_x..z,
-/// gt_acc_x..z,gt_alpha_x..z,imu_acc_x..z,imu_gyr_x..z,rpm_1..rpm_4; SOURCE.md). Rotor speeds are
+/// gt_acc_x..z,gt_alpha_x..z,imu_acc_x..z,imu_gyr_x..z,rpm_1..rpm_4; docs/estimator_real_data.md). Rotor speeds are
 /// converted from rpm to rad/s. Throws InputError (`path:line:column: error: ...`) for a missing file,
 /// a header that differs, a wrong field count, a non-finite number, a zero quaternion, a negative
 /// rotor speed or time stamps that do not increase.
 std::vector<ThrustSample> ReadDidoCsv(const std::string& path);
 
 /// DIDO's identified parameters of one sequence (`*.dynamic_params.csv`: kf_massnorm, D_x, D_y, D_z,
-/// t_imu_to_body_x..z, pitch_ex_deg, roll_ex_deg; SOURCE.md, Translation_stage.py) converted to SI:
+/// t_imu_to_body_x..z, pitch_ex_deg, roll_ex_deg; docs/estimator_real_data.md) converted to SI:
 /// kf is (m/s²)/(1e4 rpm)² per Σu_i², so k = kf (30 / (π 1e4))² (m/s²)/(rad/s)²; D is per Σu_i in
 /// 1e4 rpm, so D_SI = D · 30 / (π 1e4); |g| = 9.8 (DIDO's gravity); R_imu_thrust =
 /// (R_y(pitch) R_x(roll))ᵀ (scipy from_euler("xyz", [roll, pitch, 0]).T, "rigid2imu").
@@ -66,23 +66,26 @@ ThrustFlight ReadDidoFlight(const std::string& csv_path, std::string params_path
 
 /// Options, one default set for the simulator and the real flights (docs/estimator_real_data.md).
 struct ThrustEstimateOptions {
-  int degree = 10;                 ///< --degree, in [2, 64]
-  double segment_s = 1.0;          ///< --segment, s > 0
+  int degree = 10;                 ///< polynomial degree per segment, in [2, 64]
+  double segment_s = 1.0;          ///< segment length, s > 0
   double position_rate_hz = 30.0;  ///< rate at which the positions are used (a VO-like rate), > 0
   double position_sigma_m = 0.005; ///< σ of a position measurement, m > 0
   double position_noise_m = 0.0;   ///< white noise added to the used positions (seeded), m >= 0
   uint64_t seed = 1;               ///< of that noise
-  bool use_imu = false;            ///< --imu: also the accelerometer, at every sample
+  bool use_imu = false;            ///< also the accelerometer, at every sample
   double imu_sigma_mps2 = 0.5;     ///< σ of one accelerometer sample per axis, m/s² > 0
   double sigma_position_rate = 1e-3;   ///< collocation σ of p' = v, m/s
   double sigma_acceleration = 0.1;     ///< collocation σ of v' = f, m/s² (covers the model's error)
-  double sigma_rotor_rate = 100.0;     ///< Ω_c smoothness prior (AddControlRatePrior), rad/s² per s^(1/2); 0 = none
-  /// --rotor-delay: the rotor-speed log is taken to lag the true speeds by this much (s, |d| <= 1):
+  double sigma_rotor_rate = 100.0;     ///< Ω_c rate prior (AddControlRatePrior), rad/s² per s^(1/2) (>= 0; 0: not added)
+  /// The rotor-speed log is taken to lag the true speeds by this much (s, |d| <= 1):
   /// the measured collective compared at t is the log's (linearly interpolated) value at t + d.
   /// Evaluation only; the estimator never sees the rotor speeds.
   double rotor_delay_s = 0.0;
-  int max_iterations = 50;
-  int threads = 1;
+  int max_iterations = 50;  ///< >= 1
+  int threads = 1;          ///< >= 1
+
+  /// Throws OptionError naming the first field out of its range (above).
+  void Validate() const;
 };
 
 /// Errors of a collective rotor-speed series against the measured one (mean over the flight's
@@ -121,7 +124,7 @@ double CollectiveRotorSpeed(const Eigen::Vector4d& rotor);
 double CollectiveFromAcceleration(const ThrustParameters& parameters, const Eigen::Vector3d& a,
                                   const Eigen::Vector3d& v, const Eigen::Matrix3d& R_world_thrust);
 
-/// Estimates the flight over [first, last] sample time. Throws UsageError for bad options,
+/// Estimates the flight over [first, last] sample time. Throws OptionError for bad options,
 /// ComputeError with fewer than 3 position measurements.
 ThrustEstimate EstimateThrust(const ThrustFlight& flight, const ThrustEstimateOptions& options);
 

@@ -21,7 +21,7 @@ namespace cheval::estim {
 /// same thrust), R = R_world_thrust. This is DIDO's model (DIDO_SupMat eq. 3–7, Translation_stage.py:
 /// a_body = kf Σu_i² e3 − Σu_i diag(D) v_body) with Σu_i ≈ 4 Ω_c (exact for equal rotor speeds; with
 /// the ~2 % rms rotor spread of the DIDO flights they differ by ½(σ/μ)² ≈ 0.02 %, of a drag term below
-/// ~0.7 m/s²), plus the world-frame quadratic drag of QuadrotorModel (ESTIMATOR.md) so that the
+/// ~0.7 m/s²), plus the world-frame quadratic drag of QuadrotorModel (models.h) so that the
 /// simulator's vehicle is also described exactly.
 struct ThrustParameters {
   double thrust_per_mass = 0;                             ///< k = k_F/m: (m/s²)/(rad/s)² per rotor, > 0

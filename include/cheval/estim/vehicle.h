@@ -1,8 +1,8 @@
 #pragma once
 /// \file
-/// A quadrotor vehicle and its camera, read from a JSON file (`--vehicle FILE`; docs/estimator.md has
-/// the keys). Vehicle parameters always come from a file: the shipped default is
-/// data/vehicles/flightgoggles.json (FlightGoggles' drone, ESTIMATOR.md).
+/// A quadrotor vehicle and its camera, read from a JSON file (docs/estimator.md has the keys).
+/// Vehicle parameters always come from a file: the shipped default is
+/// data/vehicles/flightgoggles.json (FlightGoggles' drone, docs/estimator.md).
 
 #include <string>
 

@@ -1,55 +1,56 @@
 #pragma once
 /// \file
-/// The quadrotor estimator's prior on the world-frame thrust acceleration (docs/estimator.md,
-/// "Defaults"): rows linear in the thrust accelerations f_k = (k_F/m) Σ_i Ω_ik² R_k e3 of a set of
-/// nodes, with analytic Jacobians in the rotor speeds and the quaternions (ambient coordinates x, y,
-/// z, w; Ceres applies the manifold).
+/// ThrustAccelerationCost: rows linear in the world-frame thrust acceleration of a set of nodes — the
+/// residual of the quadrotor estimator's Matérn prior on the collective (docs/estimator.md, "The
+/// algorithm", step 5).
+///
+/// Contract. With f_k = (k_F/m) Σ_i Ω_ik² R_k e3 the thrust acceleration of node k (rotor speeds Ω_k,
+/// R_k from the quaternion block (x, y, z, w), world frame), coefficient rows C_a per world axis a
+/// (rows × nodes) and offsets o (rows × 3), the residual (row q, axis a) is
+/// w (Σ_k C_a(q, k) f_k[a] + o(q, a)), stored (q, a) row-major. Parameter blocks: per node its rotor
+/// speeds (4) and quaternion (4). Jacobians are analytic in the rotor speeds and in the quaternion's
+/// ambient coordinates (Ceres applies the manifold). With C_a the Gauss–Legendre rows of
+/// (D + λ_a)² over a segment, o = −λ_a² ḡ_a (the rows' sums) and w = 1/σ, the squared norm is
+/// ∫_s |(D + λ_a)² (f_a − ḡ_a)|² dt / σ², exactly.
 
 #include <array>
 #include <utility>
 #include <vector>
 
-#include <ceres/ceres.h>
 #include <Eigen/Core>
 
-#include "cheval/estim/models.h"
-#include "cheval/estim/problem.h"
+#include "cheval/estim/internal/block_cost.h"
 
-namespace cheval::estim {
+namespace cheval::estim::internal {
 
-// Rows w (Σ_k C_a(q, k) f_k[a] + o(q, a)) (axis a = x, y, z) of the thrust acceleration
-// f_k = (k_F/m) Σ_i Ω_ik² R_k e3 (world frame) of the given nodes; the parameter blocks are each node's
-// rotor speeds and quaternion. With C_a the Gauss–Legendre rows of (D + λ_a)² over a segment and
-// o = −λ_a² ḡ_a · (rows of the identity), the squared sum is ∫_s |(D + λ_a)² (f_a − ḡ_a)|² dt exactly.
-class ThrustVectorSmoothnessCost : public ceres::CostFunction {
-  using Problem = PseudoSpectralProblem<QuadrotorModel>;
-
+class ThrustAccelerationCost : public BlockCost {
  public:
-  ThrustVectorSmoothnessCost(Problem& p, const std::vector<int>& nodes, std::array<Eigen::MatrixXd, 3> coefficients,
-                             Eigen::MatrixXd offsets, double k_over_m)
+  /// `controls`, `quaternions`: the nodes' blocks (C's columns, in order). Empty offsets: zero.
+  ThrustAccelerationCost(const std::vector<double*>& controls, const std::vector<double*>& quaternions,
+                         std::array<Eigen::MatrixXd, 3> coefficients, Eigen::MatrixXd offsets, double k_over_m)
       : coefficients_(std::move(coefficients)), offsets_(std::move(offsets)), k_over_m_(k_over_m) {
-    for (int g : nodes) {
-      blocks_.push_back(p.Control(g));
-      blocks_.push_back(p.Quaternion(g));
-      mutable_parameter_block_sizes()->push_back(4);
-      mutable_parameter_block_sizes()->push_back(4);
+    for (size_t k = 0; k < controls.size(); ++k) {
+      AddBlock(controls[k], 4);
+      AddBlock(quaternions[k], 4);
     }
     if (offsets_.size() == 0) offsets_ = Eigen::MatrixXd::Zero(coefficients_[0].rows(), 3);
     set_num_residuals(3 * static_cast<int>(coefficients_[0].rows()));
   }
-  ThrustVectorSmoothnessCost(Problem& p, const std::vector<int>& nodes, const Eigen::MatrixXd& coefficients, double k_over_m)
-      : ThrustVectorSmoothnessCost(p, nodes, {coefficients, coefficients, coefficients}, Eigen::MatrixXd(), k_over_m) {}
-  const std::vector<double*>& blocks() const { return blocks_; }
+  /// The same rows C on every axis, no offsets.
+  ThrustAccelerationCost(const std::vector<double*>& controls, const std::vector<double*>& quaternions,
+                         const Eigen::MatrixXd& coefficients, double k_over_m)
+      : ThrustAccelerationCost(controls, quaternions, {coefficients, coefficients, coefficients}, Eigen::MatrixXd(),
+                               k_over_m) {}
+  /// w (1/σ).
   void set_weight(double w) { weight_ = w; }
-  void set_rows(std::array<Eigen::MatrixXd, 3> coefficients, Eigen::MatrixXd offsets) {
-    coefficients_ = std::move(coefficients);
-    offsets_ = std::move(offsets);
-  }
+
+  /// f = k_over_m |u|² R(q) e3 for rotor speeds u and a quaternion q (x, y, z, w).
   static Eigen::Vector3d ThrustAcceleration(const double* u, const double* q, double k_over_m) {
     const double x = q[0], y = q[1], z = q[2], w = q[3];
     const Eigen::Vector3d b3(2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y));
     return k_over_m * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + u[3] * u[3]) * b3;
   }
+
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const int rows = static_cast<int>(coefficients_[0].rows()), nodes = static_cast<int>(coefficients_[0].cols());
     Eigen::Map<Eigen::VectorXd> r(residuals, 3 * rows);
@@ -85,11 +86,10 @@ class ThrustVectorSmoothnessCost : public ceres::CostFunction {
   }
 
  private:
-  std::vector<double*> blocks_;
   std::array<Eigen::MatrixXd, 3> coefficients_;
   Eigen::MatrixXd offsets_;
   double k_over_m_;
   double weight_ = 1.0;
 };
 
-}  // namespace cheval::estim
+}  // namespace cheval::estim::internal
