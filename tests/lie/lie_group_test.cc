@@ -23,11 +23,16 @@
 
 #include "lie_test_util.h"
 
-// Compile every member for float too (the typed tests use double, the Jet test uses ceres::Jet).
+// Compile every member for float too (the typed tests use double, the Jet test uses ceres::Jet),
+// those each group inherits from LieGroupBase included.
 template class cheval::lie::SO3<float>;
 template class cheval::lie::SE3<float>;
 template class cheval::lie::Sim3<float>;
 template class cheval::lie::SE23<float>;
+template class cheval::lie::LieGroupBase<cheval::lie::SO3<float>, float, 3, 3>;
+template class cheval::lie::LieGroupBase<cheval::lie::SE3<float>, float, 6, 4>;
+template class cheval::lie::LieGroupBase<cheval::lie::Sim3<float>, float, 7, 4>;
+template class cheval::lie::LieGroupBase<cheval::lie::SE23<float>, float, 9, 5>;
 
 namespace cheval::lie {
 namespace {
@@ -241,6 +246,30 @@ TYPED_TEST(LieGroupTest, PlusAndMinusRoundTrip) {
   }
 }
 
+TYPED_TEST(LieGroupTest, PlusZeroAndMinusSelf) {
+  using G = TypeParam;
+  for (const auto& [name, g] : ElementSamples<G>()) {
+    SCOPED_TRACE(name);
+    // Exp(0) is exactly the identity; the product is re-normalised (1 ulp).
+    EXPECT_TRUE(MatrixNear(g.Plus(G::Tangent::Zero()).Matrix(), g.Matrix(), kTol));
+    EXPECT_TRUE(MatrixNear(g.Minus(g), G::Tangent::Zero().eval(), kTol));
+  }
+}
+
+TYPED_TEST(LieGroupTest, BetweenIsTheRelativeElement) {
+  using G = TypeParam;
+  ForEachPair(ElementSamples<G>(), 1, [](const G& g, const G& h) {
+    const G between = g.Between(h);
+    // The same operations in the same order: equal to the last bit.
+    EXPECT_TRUE(MatrixNear(between.Matrix(), (g.Inverse() * h).Matrix(), 0.0));
+    EXPECT_EQ(h.Minus(g), between.Log());
+    EXPECT_TRUE(MatrixNear((g * between).Matrix(), h.Matrix(), kTol));
+    EXPECT_TRUE(MatrixNear(g.Between(g).Matrix(), G::MatrixType::Identity(), kTol));
+    // g_a_b.Between(g_a_c) = g_b_c, and Between reversed is its inverse.
+    EXPECT_TRUE(MatrixNear(h.Between(g).Matrix(), between.Inverse().Matrix(), kTol));
+  });
+}
+
 TYPED_TEST(LieGroupTest, AdjointConjugatesTheAlgebra) {
   using G = TypeParam;
   std::mt19937 rng(kSeed);
@@ -311,6 +340,10 @@ TYPED_TEST(LieGroupTest, LeftAndRightJacobiansAreRelatedByTheAdjoint) {
     // J_l(τ) = J_r(−τ) = Adj(Exp(τ)) J_r(τ).
     EXPECT_TRUE(MatrixNear((G::Exp(tau).Adj() * G::RightJacobian(tau)).eval(),
                            G::RightJacobian(-tau), kTol));
+    EXPECT_EQ(G::LeftJacobian(tau), G::RightJacobian(-tau));
+    EXPECT_EQ(G::InverseLeftJacobian(tau), G::InverseRightJacobian(-tau));
+    EXPECT_TRUE(MatrixNear((G::LeftJacobian(tau) * G::InverseLeftJacobian(tau)).eval(),
+                           G::Jacobian::Identity(), kTol));
   }
 }
 
@@ -466,7 +499,8 @@ TEST(Sim3Test, NonPositiveScaleIsRejected) {
 // SE23
 
 TEST(SE23Test, FrobeniusErrorSplitsIntoRotationPositionVelocity) {
-  // METRICS.md §8: for E = Q⁻¹ P, ‖E − I₅‖²_F = ‖R_Qᵀ R_P − I‖²_F + |p_P − p_Q|² + |v_P − v_Q|².
+  // docs/lie.md (the ASE): for E = Q⁻¹ P, ‖E − I₅‖²_F = ‖R_Qᵀ R_P − I‖²_F + |p_P − p_Q|² +
+  // |v_P − v_Q|².
   const std::vector<Sample<SE23d>> s = ElementSamples<SE23d>();
   for (std::size_t i = 0; i < s.size(); ++i) {
     SCOPED_TRACE(s[i].name);

@@ -1,6 +1,7 @@
-// Every analytic Jacobian of SO3, SE3, Sim3 and SE23 (Exp, Log, Inverse, Compose, Act, Plus, Minus;
-// SE23's ActVelocity) against central differences on the manifold: the argument is perturbed by
-// Plus (or +) and the result differenced by Minus (or −), as GTSAM's numericalDerivative does.
+// Every analytic Jacobian of SO3, SE3, Sim3 and SE23 (Exp, Log, Inverse, Compose, Act, Plus, Minus,
+// Between, the left Jacobian; SE23's ActVelocity) against central differences on the manifold: the
+// argument is perturbed by Plus (or +) and the result differenced by Minus (or −), as GTSAM's
+// numericalDerivative does.
 
 #include <algorithm>
 #include <cmath>
@@ -131,18 +132,21 @@ TYPED_TEST(LieJacobianTest, Inverse) {
   }
 }
 
+// The Jacobians of op(a, b, J_a*, J_b*) (kCompose, kBetween) at (g, h) against central differences
+// in each argument.
+template <typename G, typename Op>
+void ExpectBothSidesNear(const G& g, const G& h, const Op& op) {
+  typename G::Jacobian j_self, j_other;
+  op(g, h, &j_self, &j_other);
+  const auto on_self = [&](const G& x) { return op(x, h, nullptr, nullptr); };
+  const auto on_other = [&](const G& x) { return op(g, x, nullptr, nullptr); };
+  EXPECT_TRUE(JacobianNear(j_self, NumericalJacobian(on_self, g)));
+  EXPECT_TRUE(JacobianNear(j_other, NumericalJacobian(on_other, h)));
+}
+
 TYPED_TEST(LieJacobianTest, ComposeBothSides) {
-  using G = TypeParam;
-  const std::vector<Element<G>> s = ElementSamples<G>();
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    SCOPED_TRACE(s[i].name);
-    const G& g = s[i].value;
-    const G& h = s[(i + 1) % s.size()].value;
-    typename G::Jacobian j_self, j_other;
-    g.Compose(h, &j_self, &j_other);
-    EXPECT_TRUE(JacobianNear(j_self, NumericalJacobian([&h](const G& x) { return x * h; }, g)));
-    EXPECT_TRUE(JacobianNear(j_other, NumericalJacobian([&g](const G& x) { return g * x; }, h)));
-  }
+  const auto check = [](const auto& g, const auto& h) { ExpectBothSidesNear(g, h, kCompose); };
+  ForEachPair(ElementSamples<TypeParam>(), 1, check);
 }
 
 TYPED_TEST(LieJacobianTest, ActBothSides) {
@@ -197,6 +201,24 @@ TYPED_TEST(LieJacobianTest, MinusBothSides) {
         JacobianNear(j_self, NumericalJacobian([&h](const G& x) { return x.Minus(h); }, g)));
     EXPECT_TRUE(
         JacobianNear(j_other, NumericalJacobian([&g](const G& x) { return g.Minus(x); }, h)));
+  }
+}
+
+TYPED_TEST(LieJacobianTest, BetweenBothSides) {
+  const auto check = [](const auto& g, const auto& h) { ExpectBothSidesNear(g, h, kBetween); };
+  ForEachPair(ElementSamples<TypeParam>(), 1, check);
+}
+
+TYPED_TEST(LieJacobianTest, LeftJacobianIsTheLeftDerivativeOfExp) {
+  using G = TypeParam;
+  for (const auto& [name, tau] : TangentSamples<G>()) {
+    SCOPED_TRACE(name);
+    // Exp(τ + δ) = Exp(J_l(τ) δ) Exp(τ): J_l(τ) = ∂ Log(Exp(τ + δ) Exp(τ)⁻¹)/∂δ at δ = 0.
+    const G exp_inverse = G::Exp(tau).Inverse();
+    const auto f = [&exp_inverse](const typename G::Tangent& t) {
+      return (G::Exp(t) * exp_inverse).Log();
+    };
+    EXPECT_TRUE(JacobianNear(G::LeftJacobian(tau), NumericalJacobian(f, tau)));
   }
 }
 

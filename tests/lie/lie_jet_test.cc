@@ -1,8 +1,9 @@
 // The Lie groups with ceres::Jet scalars: every member compiles with Jets (explicit instantiation
-// below), and the derivatives that Jets carry through Exp, Log, Inverse, Compose, Act, Plus and
-// Minus equal the analytic Jacobians, at identity, tiny angles, within 1e-6 of π, exactly π and on
-// seeded random elements. Unlike finite differences this is exact up to rounding, so it also checks
-// the small-angle series branches (their derivatives) and Log right at the cut.
+// below), and the derivatives that Jets carry through Exp, Log, Inverse, Compose, Act, Plus, Minus
+// and Between (and the left Jacobian) equal the analytic Jacobians, at identity, tiny angles,
+// within 1e-6 of π, exactly π and on seeded random elements. Unlike finite differences this is
+// exact up to rounding, so it also checks the small-angle series branches (their derivatives) and
+// Log right at the cut.
 
 #include <algorithm>
 #include <cmath>
@@ -25,11 +26,20 @@
 
 #include "lie_test_util.h"
 
-// Every member function of every group, Jacobian outputs included, compiles with Jets.
+// Every member function of every group, those inherited from LieGroupBase and the Jacobian
+// outputs included, compiles with Jets.
 template class cheval::lie::SO3<ceres::Jet<double, 3>>;
 template class cheval::lie::SE3<ceres::Jet<double, 6>>;
 template class cheval::lie::Sim3<ceres::Jet<double, 7>>;
 template class cheval::lie::SE23<ceres::Jet<double, 9>>;
+template class cheval::lie::LieGroupBase<cheval::lie::SO3<ceres::Jet<double, 3>>,
+                                         ceres::Jet<double, 3>, 3, 3>;
+template class cheval::lie::LieGroupBase<cheval::lie::SE3<ceres::Jet<double, 6>>,
+                                         ceres::Jet<double, 6>, 6, 4>;
+template class cheval::lie::LieGroupBase<cheval::lie::Sim3<ceres::Jet<double, 7>>,
+                                         ceres::Jet<double, 7>, 7, 4>;
+template class cheval::lie::LieGroupBase<cheval::lie::SE23<ceres::Jet<double, 9>>,
+                                         ceres::Jet<double, 9>, 9, 5>;
 
 namespace cheval::lie {
 namespace {
@@ -128,6 +138,20 @@ TYPED_TEST(LieJetTest, Exp) {
   }
 }
 
+TYPED_TEST(LieJetTest, LeftJacobian) {
+  using G = TypeParam;
+  for (const auto& [name, tau] : TangentSamples<G>()) {
+    SCOPED_TRACE(name);
+    // Exp(τ + δ) = Exp(J_l(τ) δ) Exp(τ): J_l(τ) = ∂ Log(Exp(τ + δ) Exp(τ)⁻¹)/∂δ at δ = 0.
+    const auto f = [&tau](const auto& t) {
+      using GS = typename Rebind<G, ScalarOf<decltype(t)>>::type;
+      return (GS::Exp(t) * GS::Exp(tau.template cast<ScalarOf<decltype(t)>>().eval()).Inverse())
+          .Log();
+    };
+    EXPECT_TRUE(JacobianNear(G::LeftJacobian(tau), AutoDiffJacobian(f, tau)));
+  }
+}
+
 TYPED_TEST(LieJetTest, Log) {
   using G = TypeParam;
   for (const auto& [name, g] : ElementSamples<G>()) {
@@ -148,20 +172,25 @@ TYPED_TEST(LieJetTest, Inverse) {
   }
 }
 
+// The Jacobians of op(a, b, J_a*, J_b*) (Compose, Between; op generic in the scalar) at (g, h)
+// against autodiff in each argument.
+template <typename G, typename Op>
+void ExpectBothSidesNear(const G& g, const G& h, const Op& op) {
+  typename G::Jacobian j_self, j_other;
+  op(g, h, &j_self, &j_other);
+  const auto on_self = [&](const auto& x) {
+    return op(x, h.template Cast<ScalarOf<decltype(x)>>(), nullptr, nullptr);
+  };
+  const auto on_other = [&](const auto& x) {
+    return op(g.template Cast<ScalarOf<decltype(x)>>(), x, nullptr, nullptr);
+  };
+  EXPECT_TRUE(JacobianNear(j_self, AutoDiffJacobian(on_self, g)));
+  EXPECT_TRUE(JacobianNear(j_other, AutoDiffJacobian(on_other, h)));
+}
+
 TYPED_TEST(LieJetTest, ComposeBothSides) {
-  using G = TypeParam;
-  const std::vector<Sample<G>> s = ElementSamples<G>();
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    SCOPED_TRACE(s[i].name);
-    const G& g = s[i].value;
-    const G& h = s[(i + 1) % s.size()].value;
-    typename G::Jacobian j_self, j_other;
-    g.Compose(h, &j_self, &j_other);
-    const auto right = [&h](const auto& x) { return x * h.template Cast<ScalarOf<decltype(x)>>(); };
-    const auto left = [&g](const auto& x) { return g.template Cast<ScalarOf<decltype(x)>>() * x; };
-    EXPECT_TRUE(JacobianNear(j_self, AutoDiffJacobian(right, g)));
-    EXPECT_TRUE(JacobianNear(j_other, AutoDiffJacobian(left, h)));
-  }
+  const auto check = [](const auto& g, const auto& h) { ExpectBothSidesNear(g, h, kCompose); };
+  ForEachPair(ElementSamples<TypeParam>(), 1, check);
 }
 
 TYPED_TEST(LieJetTest, ActBothSides) {
@@ -226,6 +255,11 @@ TYPED_TEST(LieJetTest, MinusBothSides) {
     EXPECT_TRUE(JacobianNear(j_self, AutoDiffJacobian(on_self, g)));
     EXPECT_TRUE(JacobianNear(j_other, AutoDiffJacobian(on_other, h)));
   }
+}
+
+TYPED_TEST(LieJetTest, BetweenBothSides) {
+  const auto check = [](const auto& g, const auto& h) { ExpectBothSidesNear(g, h, kBetween); };
+  ForEachPair(ElementSamples<TypeParam>(), 1, check);
 }
 
 TEST(SE23JetTest, ActVelocityBothSides) {

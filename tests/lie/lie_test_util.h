@@ -1,7 +1,8 @@
 // Helpers shared by the Lie-group tests (lie_group_test.cc, lie_jacobian_test.cc, lie_jet_test.cc):
-// seeded random draws, the tangent sample list, elements with a given rotation, the typed-test
-// group list and its name printer, manifold perturbation and a relative Jacobian comparison. Each
-// test file keeps its own seed and tolerances.
+// seeded random draws, the tangent sample list, pairs of samples, elements with a given rotation,
+// the typed-test group list and its name printer, Compose and Between as callables, manifold
+// perturbation and a relative Jacobian comparison. Each test file keeps its own seed and
+// tolerances.
 
 #pragma once
 
@@ -98,6 +99,24 @@ std::vector<Sample<typename G::Tangent>> MakeTangentSamples(unsigned seed, const
   }
   return s;
 }
+
+// Calls f(g, h) for each sample g of s and the sample `offset` places after it (cyclically), under
+// a SCOPED_TRACE of g's name.
+template <typename S, typename F>
+void ForEachPair(const std::vector<S>& s, std::size_t offset, const F& f) {
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    SCOPED_TRACE(s[i].name);
+    f(s[i].value, s[(i + offset) % s.size()].value);
+  }
+}
+
+// Compose and Between as callables op(a, b, J_a*, J_b*), for tests of both Jacobians.
+inline constexpr auto kCompose = [](const auto& a, const auto& b, auto j_a, auto j_b) {
+  return a.Compose(b, j_a, j_b);
+};
+inline constexpr auto kBetween = [](const auto& a, const auto& b, auto j_a, auto j_b) {
+  return a.Between(b, j_a, j_b);
+};
 
 // An element of G with rotation r and its other parts random of size `extent` (log-scale ≤ 1).
 template <typename G>

@@ -3,7 +3,7 @@
 /// SE_2(3), the group of extended poses (R, p, v) = [[R p v], [0 1 0], [0 0 1]] (5x5) of a
 /// navigation state: attitude, position and linear velocity, templated on the scalar so that
 /// ceres::Jet passes through. Composition (R1R2, R1p2 + p1, R1v2 + v1), inverse (Rᵀ, −Rᵀp, −Rᵀv)
-/// (METRICS.md §8).
+/// (the state of the ASE, docs/lie.md).
 ///
 /// | group | storage (order)                   | tangent τ (order)                 | dim |
 /// |-------|-----------------------------------|-----------------------------------|-----|
@@ -13,8 +13,9 @@
 /// cheval puts rotation first in every group, in storage and in the tangent.)
 ///
 /// Exp(ω, ρ_p, ρ_v) = (Exp(ω), V ρ_p, V ρ_v) with V = SO3::LeftJacobian(ω) for both. The
-/// conventions for Plus/Minus, Jacobians and Adj are those of so3.h. A state X = X_w_b holds
-/// R_w_b, the position p of b in w (metres) and the velocity v of b in w (m/s, world frame).
+/// conventions for Plus/Minus, Jacobians and Adj are those of lie_group_base.h. A state
+/// X = X_w_b holds R_w_b, the position p of b in w (metres) and the velocity v of b in w (m/s,
+/// world frame).
 
 #include <string_view>
 
@@ -22,41 +23,20 @@
 #include <Eigen/Geometry>
 
 #include "cheval/lie/detail.h"
+#include "cheval/lie/lie_group_base.h"
 #include "cheval/lie/so3.h"
 
 namespace cheval::lie {
 
 /// An extended pose (R, p, v); tangent (ω, ρ_p, ρ_v) ∈ R⁹, rotation first.
 template <typename T>
-class SE23 {
+class SE23 : public LieGroupBase<SE23<T>, T, 9, 5> {
  public:
-  /// The scalar type (double, float or ceres::Jet).
-  using Scalar = T;
-  /// Tangent dimension (degrees of freedom).
-  static constexpr int kDoF = 9;
-  /// Size of the square matrix returned by Matrix().
-  static constexpr int kMatrixDim = 5;
+  /// The base: the types (Tangent, Jacobian, ...) and the algebra shared by the groups.
+  using Base = LieGroupBase<SE23<T>, T, 9, 5>;
+  CHEVAL_LIE_GROUP_TYPES(Base);
   /// Name of the group, for messages.
   static constexpr std::string_view kName = "SE23";
-
-  /// Tangent vector (ω, ρ_p, ρ_v): rotation vector ω (radians) first.
-  using Tangent = Eigen::Matrix<Scalar, kDoF, 1>;
-  /// A 3D point or vector.
-  using Point = Eigen::Matrix<Scalar, 3, 1>;
-  /// 3-vector.
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  /// Jacobian of a group or tangent result with respect to a group or tangent argument.
-  using Jacobian = Eigen::Matrix<Scalar, kDoF, kDoF>;
-  /// Jacobian of a point (or velocity) result with respect to the group.
-  using PointJacobian = Eigen::Matrix<Scalar, 3, kDoF>;
-  /// 3x3 matrix.
-  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
-  /// The 5x5 matrix of the group element.
-  using MatrixType = Eigen::Matrix<Scalar, kMatrixDim, kMatrixDim>;
-  /// Matrix of the (group or Lie algebra) adjoint.
-  using AdjointMatrix = Eigen::Matrix<Scalar, kDoF, kDoF>;
-  /// Quaternion type of the rotation.
-  using Quaternion = Eigen::Quaternion<Scalar>;
 
   /// The identity state (R = I, p = 0, v = 0).
   SE23() : position_(Vector3::Zero()), velocity_(Vector3::Zero()) {}
@@ -72,9 +52,6 @@ class SE23 {
   /// The state (R, p, v) from a rotation matrix (precondition as SO3(const Matrix3&)).
   SE23(const Matrix3& rotation, const Vector3& position, const Vector3& velocity)
       : rotation_(rotation), position_(position), velocity_(velocity) {}
-
-  /// The identity state.
-  static SE23 Identity() { return SE23(); }
 
   /// The state exp(Hat(τ)) = (Exp(ω), J_l(ω) ρ_p, J_l(ω) ρ_v). Valid for all τ.
   /// J_out_tangent (optional) = RightJacobian(τ).
@@ -117,9 +94,6 @@ class SE23 {
                 rotation_.Act(other.velocity_) + velocity_);
   }
 
-  /// The composition *this · other; same as Compose(other).
-  SE23 operator*(const SE23& other) const { return Compose(other); }
-
   /// The transformed point R x + p, as SE3 with (R, p): the 5x5 matrix applied to [x; 1; 0].
   /// J_out_self (optional) = [−R [x]×, R, 0]; J_out_point (optional) = R.
   Point Act(const Point& x, PointJacobian* J_out_self = nullptr,
@@ -145,12 +119,11 @@ class SE23 {
   /// The adjoint matrix [[R, 0, 0], [[p]× R, R, 0], [[v]× R, 0, R]] (blocks ω, ρ_p, ρ_v).
   AdjointMatrix Adj() const {
     const Matrix3 r = rotation_.Matrix();
-    AdjointMatrix adj = AdjointMatrix::Zero();
-    adj.template block<3, 3>(0, 0) = r;
-    adj.template block<3, 3>(3, 0) = detail::Hat3(position_) * r;
-    adj.template block<3, 3>(3, 3) = r;
-    adj.template block<3, 3>(6, 0) = detail::Hat3(velocity_) * r;
-    adj.template block<3, 3>(6, 6) = r;
+    const Matrix3 zero = Matrix3::Zero();
+    AdjointMatrix adj;
+    adj << r, zero, zero,                        //
+        detail::Hat3(position_) * r, r, zero,  //
+        detail::Hat3(velocity_) * r, zero, r;
     return adj;
   }
 
@@ -176,32 +149,12 @@ class SE23 {
   /// [[ [ω]×, 0, 0 ], [ [ρ_p]×, [ω]×, 0 ], [ [ρ_v]×, 0, [ω]× ]].
   static AdjointMatrix SmallAdj(const Tangent& tau) {
     const Matrix3 w = detail::Hat3<Scalar>(tau.template head<3>());
-    AdjointMatrix ad = AdjointMatrix::Zero();
-    ad.template block<3, 3>(0, 0) = w;
-    ad.template block<3, 3>(3, 0) = detail::Hat3<Scalar>(tau.template segment<3>(3));
-    ad.template block<3, 3>(3, 3) = w;
-    ad.template block<3, 3>(6, 0) = detail::Hat3<Scalar>(tau.template segment<3>(6));
-    ad.template block<3, 3>(6, 6) = w;
+    const Matrix3 zero = Matrix3::Zero();
+    AdjointMatrix ad;
+    ad << w, zero, zero,                                              //
+        detail::Hat3<Scalar>(tau.template segment<3>(3)), w, zero,  //
+        detail::Hat3<Scalar>(tau.template segment<3>(6)), zero, w;
     return ad;
-  }
-
-  /// Right plus g ⊕ τ = g · Exp(τ). J_out_self (optional) = Adj(Exp(τ))⁻¹;
-  /// J_out_tangent (optional) = RightJacobian(τ).
-  SE23 Plus(const Tangent& tau, Jacobian* J_out_self = nullptr,
-            Jacobian* J_out_tangent = nullptr) const {
-    const SE23 delta = Exp(tau, J_out_tangent);
-    if (J_out_self != nullptr) *J_out_self = delta.Inverse().Adj();
-    return Compose(delta);
-  }
-
-  /// Right minus g ⊖ other = Log(other⁻¹ · g). J_out_self (optional) = J_r⁻¹(τ);
-  /// J_out_other (optional) = −J_r⁻¹(−τ).
-  Tangent Minus(const SE23& other, Jacobian* J_out_self = nullptr,
-                Jacobian* J_out_other = nullptr) const {
-    const Tangent tau = other.Inverse().Compose(*this).Log();
-    if (J_out_self != nullptr) *J_out_self = InverseRightJacobian(tau);
-    if (J_out_other != nullptr) *J_out_other = -InverseRightJacobian(-tau);
-    return tau;
   }
 
   /// The 5x5 matrix [[R p v], [0 1 0], [0 0 1]].

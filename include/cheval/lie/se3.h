@@ -8,10 +8,10 @@
 /// | SE3   | (SO3 R, translation t)| (ω, ρ), rotation first| 6   |
 ///
 /// Exp(ω, ρ) = (Exp(ω), V ρ) with V = SO3::LeftJacobian(ω). Note ρ is not the translation: t = V ρ.
-/// The conventions for Plus/Minus, Jacobians and Adj are those of so3.h (right perturbations,
-/// optional Jacobian outputs, Adj(g) τ = Vee(g Hat(τ) g⁻¹)). A pose T = T_a_b maps points of frame
-/// b to frame a: p_a = R_a_b p_b + t_a_b (t is the origin of b in a). Units: radians and the unit
-/// of t (metres in cheval).
+/// The conventions for Plus/Minus, Jacobians and Adj are those of lie_group_base.h (right
+/// perturbations, optional Jacobian outputs, Adj(g) τ = Vee(g Hat(τ) g⁻¹)). A pose T = T_a_b maps
+/// points of frame b to frame a: p_a = R_a_b p_b + t_a_b (t is the origin of b in a). Units:
+/// radians and the unit of t (metres in cheval).
 
 #include <string_view>
 
@@ -19,41 +19,20 @@
 #include <Eigen/Geometry>
 
 #include "cheval/lie/detail.h"
+#include "cheval/lie/lie_group_base.h"
 #include "cheval/lie/so3.h"
 
 namespace cheval::lie {
 
 /// A rigid-body motion (R, t) acting as p ↦ R p + t; tangent (ω, ρ) ∈ R⁶, rotation first.
 template <typename T>
-class SE3 {
+class SE3 : public LieGroupBase<SE3<T>, T, 6, 4> {
  public:
-  /// The scalar type (double, float or ceres::Jet).
-  using Scalar = T;
-  /// Tangent dimension (degrees of freedom).
-  static constexpr int kDoF = 6;
-  /// Size of the square matrix returned by Matrix().
-  static constexpr int kMatrixDim = 4;
+  /// The base: the types (Tangent, Jacobian, ...) and the algebra shared by the groups.
+  using Base = LieGroupBase<SE3<T>, T, 6, 4>;
+  CHEVAL_LIE_GROUP_TYPES(Base);
   /// Name of the group, for messages.
   static constexpr std::string_view kName = "SE3";
-
-  /// Tangent vector (ω, ρ): rotation vector ω (radians) first, then ρ (units of t).
-  using Tangent = Eigen::Matrix<Scalar, kDoF, 1>;
-  /// A 3D point or vector.
-  using Point = Eigen::Matrix<Scalar, 3, 1>;
-  /// 3-vector.
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  /// Jacobian of a group or tangent result with respect to a group or tangent argument.
-  using Jacobian = Eigen::Matrix<Scalar, kDoF, kDoF>;
-  /// Jacobian of a point result with respect to the group.
-  using PointJacobian = Eigen::Matrix<Scalar, 3, kDoF>;
-  /// 3x3 matrix.
-  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
-  /// Homogeneous 4x4 matrix of the group element.
-  using MatrixType = Eigen::Matrix<Scalar, kMatrixDim, kMatrixDim>;
-  /// Matrix of the (group or Lie algebra) adjoint.
-  using AdjointMatrix = Eigen::Matrix<Scalar, kDoF, kDoF>;
-  /// Quaternion type of the rotation.
-  using Quaternion = Eigen::Quaternion<Scalar>;
 
   /// The identity motion.
   SE3() : translation_(Vector3::Zero()) {}
@@ -68,9 +47,6 @@ class SE3 {
   /// The motion (R, t) from a rotation matrix (precondition as SO3(const Matrix3&)).
   SE3(const Matrix3& rotation, const Vector3& translation)
       : rotation_(rotation), translation_(translation) {}
-
-  /// The identity motion.
-  static SE3 Identity() { return SE3(); }
 
   /// The motion exp(Hat(τ)) = (Exp(ω), J_l(ω) ρ). Valid for all τ.
   /// J_out_tangent (optional) = RightJacobian(τ).
@@ -107,9 +83,6 @@ class SE3 {
     if (J_out_other != nullptr) J_out_other->setIdentity();
     return SE3(rotation_ * other.rotation_, rotation_.Act(other.translation_) + translation_);
   }
-
-  /// The composition *this · other; same as Compose(other).
-  SE3 operator*(const SE3& other) const { return Compose(other); }
 
   /// The transformed point R p + t (p_a = T_a_b · p_b).
   /// J_out_self (optional) = [−R [p]×, R]; J_out_point (optional) = R.
@@ -151,25 +124,6 @@ class SE3 {
     AdjointMatrix ad;
     ad << w, Matrix3::Zero(), detail::Hat3<Scalar>(tau.template tail<3>()), w;
     return ad;
-  }
-
-  /// Right plus g ⊕ τ = g · Exp(τ). J_out_self (optional) = Adj(Exp(τ))⁻¹;
-  /// J_out_tangent (optional) = RightJacobian(τ).
-  SE3 Plus(const Tangent& tau, Jacobian* J_out_self = nullptr,
-           Jacobian* J_out_tangent = nullptr) const {
-    const SE3 delta = Exp(tau, J_out_tangent);
-    if (J_out_self != nullptr) *J_out_self = delta.Inverse().Adj();
-    return Compose(delta);
-  }
-
-  /// Right minus g ⊖ other = Log(other⁻¹ · g). J_out_self (optional) = J_r⁻¹(τ);
-  /// J_out_other (optional) = −J_r⁻¹(−τ).
-  Tangent Minus(const SE3& other, Jacobian* J_out_self = nullptr,
-                Jacobian* J_out_other = nullptr) const {
-    const Tangent tau = other.Inverse().Compose(*this).Log();
-    if (J_out_self != nullptr) *J_out_self = InverseRightJacobian(tau);
-    if (J_out_other != nullptr) *J_out_other = -InverseRightJacobian(-tau);
-    return tau;
   }
 
   /// The homogeneous 4x4 matrix [R t; 0 1].

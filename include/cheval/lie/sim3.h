@@ -11,8 +11,9 @@
 /// the closed form of E. Eade, "Lie Groups for 2D and 3D Transformations" (Sim(3) section), with
 /// F(z) = (e^z − 1)/z at z = σ and z = σ + iθ (detail::ComputeSim3Coefficients). The right Jacobian
 /// is analytic (closed form, no series in ad): see RightJacobian. The conventions for Plus/Minus,
-/// Jacobians and Adj are those of so3.h. S = S_a_b maps p_b to p_a = s R p_b + t. Units: radians,
-/// the unit of t, and σ dimensionless. Valid for |σ| < 700 (e^σ must not overflow).
+/// Jacobians and Adj are those of lie_group_base.h. S = S_a_b maps p_b to p_a = s R p_b + t.
+/// Units: radians, the unit of t, and σ dimensionless. Valid for |σ| < 700 (e^σ must not
+/// overflow).
 
 #include <sstream>
 #include <string_view>
@@ -24,41 +25,20 @@
 
 #include "cheval/common/error.h"
 #include "cheval/lie/detail.h"
+#include "cheval/lie/lie_group_base.h"
 #include "cheval/lie/so3.h"
 
 namespace cheval::lie {
 
 /// A similarity (R, t, s) acting as p ↦ s R p + t; tangent (ω, ρ, σ) ∈ R⁷, rotation first.
 template <typename T>
-class Sim3 {
+class Sim3 : public LieGroupBase<Sim3<T>, T, 7, 4> {
  public:
-  /// The scalar type (double, float or ceres::Jet).
-  using Scalar = T;
-  /// Tangent dimension (degrees of freedom).
-  static constexpr int kDoF = 7;
-  /// Size of the square matrix returned by Matrix().
-  static constexpr int kMatrixDim = 4;
+  /// The base: the types (Tangent, Jacobian, ...) and the algebra shared by the groups.
+  using Base = LieGroupBase<Sim3<T>, T, 7, 4>;
+  CHEVAL_LIE_GROUP_TYPES(Base);
   /// Name of the group, for messages.
   static constexpr std::string_view kName = "Sim3";
-
-  /// Tangent vector (ω, ρ, σ): rotation vector ω (radians), ρ (units of t), σ = log of the scale.
-  using Tangent = Eigen::Matrix<Scalar, kDoF, 1>;
-  /// A 3D point or vector.
-  using Point = Eigen::Matrix<Scalar, 3, 1>;
-  /// 3-vector.
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  /// Jacobian of a group or tangent result with respect to a group or tangent argument.
-  using Jacobian = Eigen::Matrix<Scalar, kDoF, kDoF>;
-  /// Jacobian of a point result with respect to the group.
-  using PointJacobian = Eigen::Matrix<Scalar, 3, kDoF>;
-  /// 3x3 matrix.
-  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
-  /// Homogeneous 4x4 matrix of the group element.
-  using MatrixType = Eigen::Matrix<Scalar, kMatrixDim, kMatrixDim>;
-  /// Matrix of the (group or Lie algebra) adjoint.
-  using AdjointMatrix = Eigen::Matrix<Scalar, kDoF, kDoF>;
-  /// Quaternion type of the rotation.
-  using Quaternion = Eigen::Quaternion<Scalar>;
 
   /// The identity similarity.
   Sim3() : translation_(Vector3::Zero()), scale_(Scalar(1)) {}
@@ -75,9 +55,6 @@ class Sim3 {
   /// Throws cheval::ComputeError unless s > 0.
   Sim3(const Matrix3& rotation, const Vector3& translation, const Scalar& scale)
       : Sim3(SO3<Scalar>(rotation), translation, scale) {}
-
-  /// The identity similarity.
-  static Sim3 Identity() { return Sim3(); }
 
   /// The similarity exp(Hat(τ)) = (Exp(ω), W(ω, σ) ρ, e^σ). Valid for all ω and |σ| < 700.
   /// J_out_tangent (optional) = RightJacobian(τ).
@@ -120,9 +97,6 @@ class Sim3 {
     return Sim3(rotation_ * other.rotation_,
                 scale_ * rotation_.Act(other.translation_) + translation_, scale_ * other.scale_);
   }
-
-  /// The composition *this · other; same as Compose(other).
-  Sim3 operator*(const Sim3& other) const { return Compose(other); }
 
   /// The transformed point s R p + t.
   /// J_out_self (optional) = [−s R [p]×, s R, s R p]; J_out_point (optional) = s R.
@@ -176,25 +150,6 @@ class Sim3 {
     ad.template block<3, 3>(3, 3) = w + tau[6] * Matrix3::Identity();
     ad.template block<3, 1>(3, 6) = -tau.template segment<3>(3);
     return ad;
-  }
-
-  /// Right plus g ⊕ τ = g · Exp(τ). J_out_self (optional) = Adj(Exp(τ))⁻¹;
-  /// J_out_tangent (optional) = RightJacobian(τ).
-  Sim3 Plus(const Tangent& tau, Jacobian* J_out_self = nullptr,
-            Jacobian* J_out_tangent = nullptr) const {
-    const Sim3 delta = Exp(tau, J_out_tangent);
-    if (J_out_self != nullptr) *J_out_self = delta.Inverse().Adj();
-    return Compose(delta);
-  }
-
-  /// Right minus g ⊖ other = Log(other⁻¹ · g). J_out_self (optional) = J_r⁻¹(τ);
-  /// J_out_other (optional) = −J_r⁻¹(−τ).
-  Tangent Minus(const Sim3& other, Jacobian* J_out_self = nullptr,
-                Jacobian* J_out_other = nullptr) const {
-    const Tangent tau = other.Inverse().Compose(*this).Log();
-    if (J_out_self != nullptr) *J_out_self = InverseRightJacobian(tau);
-    if (J_out_other != nullptr) *J_out_other = -InverseRightJacobian(-tau);
-    return tau;
   }
 
   /// The homogeneous 4x4 matrix [s R t; 0 1].

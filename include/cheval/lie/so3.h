@@ -6,18 +6,8 @@
 /// |-------|--------------------------------------------|---------------------|-----|
 /// | SO3   | unit quaternion q (Eigen order x, y, z, w) | ω (rotation vector) | 3   |
 ///
-/// (docs/lie.md has the table for all four groups: rotation always comes first.)
-///
-/// Conventions shared by all cheval::lie groups:
-/// - Exp(τ) = exp(Hat(τ)); Log is its inverse with rotation angle θ = |ω| ∈ [0, π].
-/// - Right perturbations: g ⊕ τ = g · Exp(τ) (Plus) and h ⊖ g = Log(g⁻¹ · h) (Minus).
-/// - Jacobians are optional outputs (nullptr = not wanted) defined on the right: for f: G → H,
-///   J = ∂(f(g ⊕ δ) ⊖ f(g))/∂δ at δ = 0; for a vector result, ∂f(g ⊕ δ)/∂δ; for a vector argument,
-///   the ordinary derivative. The right Jacobian J_r(τ) is defined by
-///   Exp(τ + δ) ≈ Exp(τ) Exp(J_r(τ) δ).
-/// - Adj(g) τ = Vee(g Hat(τ) g⁻¹), so g Exp(τ) = Exp(Adj(g) τ) g.
-/// - Small angles use Taylor series in θ² below a threshold (not only at θ = 0), so values and Jet
-///   derivatives are finite and accurate everywhere; see detail.h.
+/// (docs/lie.md has the table for all four groups: rotation always comes first.) Plus, Minus,
+/// Between, the left Jacobians and the conventions shared by all groups are in lie_group_base.h.
 ///
 /// A rotation R = R_a_b maps coordinates in frame b to frame a: p_a = R_a_b p_b. Angles in radians.
 
@@ -28,38 +18,19 @@
 #include <Eigen/Geometry>
 
 #include "cheval/lie/detail.h"
+#include "cheval/lie/lie_group_base.h"
 
 namespace cheval::lie {
 
 /// A 3D rotation stored as a unit quaternion; tangent ω ∈ R³ (axis · angle, radians).
 template <typename T>
-class SO3 {
+class SO3 : public LieGroupBase<SO3<T>, T, 3, 3> {
  public:
-  /// The scalar type (double, float or ceres::Jet).
-  using Scalar = T;
-  /// Tangent dimension (degrees of freedom).
-  static constexpr int kDoF = 3;
-  /// Size of the square matrix returned by Matrix().
-  static constexpr int kMatrixDim = 3;
+  /// The base: the types (Tangent, Jacobian, ...) and the algebra shared by the groups.
+  using Base = LieGroupBase<SO3<T>, T, 3, 3>;
+  CHEVAL_LIE_GROUP_TYPES(Base);
   /// Name of the group, for messages.
   static constexpr std::string_view kName = "SO3";
-
-  /// Tangent vector ω (rotation vector, radians).
-  using Tangent = Eigen::Matrix<Scalar, 3, 1>;
-  /// A 3D point or vector.
-  using Point = Eigen::Matrix<Scalar, 3, 1>;
-  /// Jacobian of a group or tangent result with respect to a group or tangent argument.
-  using Jacobian = Eigen::Matrix<Scalar, kDoF, kDoF>;
-  /// Jacobian of a point result with respect to the group.
-  using PointJacobian = Eigen::Matrix<Scalar, 3, kDoF>;
-  /// 3x3 matrix.
-  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
-  /// Matrix of the group element, kMatrixDim x kMatrixDim.
-  using MatrixType = Eigen::Matrix<Scalar, kMatrixDim, kMatrixDim>;
-  /// Matrix of the (group or Lie algebra) adjoint.
-  using AdjointMatrix = Eigen::Matrix<Scalar, kDoF, kDoF>;
-  /// Quaternion type of the storage.
-  using Quaternion = Eigen::Quaternion<Scalar>;
 
   /// The identity rotation.
   SO3() : q_(Quaternion::Identity()) {}
@@ -71,9 +42,6 @@ class SO3 {
   /// non-orthonormal r gives the unit quaternion of Shepperd's method (largest-pivot branch)
   /// normalised, a nearby rotation.
   explicit SO3(const Matrix3& r) : q_(Normalized(QuaternionFromMatrix(r))) {}
-
-  /// The identity rotation.
-  static SO3 Identity() { return SO3(); }
 
   /// The rotation exp([ω]×) = Rodrigues' formula, by angle |ω| about ω/|ω| (any |ω|).
   /// J_out_tangent (optional) = RightJacobian(ω).
@@ -120,9 +88,6 @@ class SO3 {
     return result;
   }
 
-  /// The composition *this · other; same as Compose(other).
-  SO3 operator*(const SO3& other) const { return Compose(other); }
-
   /// The rotated point R p (p in the frame on the right of R, result in the frame on the left).
   /// J_out_self (optional) = −R [p]×; J_out_point (optional) = R.
   Point Act(const Point& p, PointJacobian* J_out_self = nullptr,
@@ -144,25 +109,6 @@ class SO3 {
 
   /// The matrix ad_ω of the Lie bracket, ad_ω ξ = Vee([Hat(ω), Hat(ξ)]) = [ω]× ξ.
   static AdjointMatrix SmallAdj(const Tangent& omega) { return detail::Hat3(omega); }
-
-  /// Right plus g ⊕ τ = g · Exp(τ). J_out_self (optional) = Adj(Exp(τ))⁻¹ = Exp(τ)ᵀ;
-  /// J_out_tangent (optional) = RightJacobian(τ).
-  SO3 Plus(const Tangent& tau, Jacobian* J_out_self = nullptr,
-           Jacobian* J_out_tangent = nullptr) const {
-    const SO3 delta = Exp(tau, J_out_tangent);
-    if (J_out_self != nullptr) *J_out_self = delta.Matrix().transpose();
-    return Compose(delta);
-  }
-
-  /// Right minus g ⊖ other = Log(other⁻¹ · g), the rotation vector from other to *this in the
-  /// frame of other. J_out_self (optional) = J_r⁻¹(τ); J_out_other (optional) = −J_r⁻¹(−τ).
-  Tangent Minus(const SO3& other, Jacobian* J_out_self = nullptr,
-                Jacobian* J_out_other = nullptr) const {
-    const Tangent tau = other.Inverse().Compose(*this).Log();
-    if (J_out_self != nullptr) *J_out_self = InverseRightJacobian(tau);
-    if (J_out_other != nullptr) *J_out_other = -InverseRightJacobian(-tau);
-    return tau;
-  }
 
   /// The 3x3 rotation matrix R.
   MatrixType Matrix() const { return q_.toRotationMatrix(); }
@@ -192,13 +138,6 @@ class SO3 {
     const Matrix3 k = detail::Hat3(omega);
     return Matrix3::Identity() + Scalar(0.5) * k + d * k * k;
   }
-
-  /// Left Jacobian J_l(ω) = J_r(−ω) = R J_r(ω) = I + A [ω]× + B [ω]×²; Exp(ω + δ) ≈
-  /// Exp(J_l(ω) δ) Exp(ω). It is also the matrix V of the SE(3) exponential, t = V ρ.
-  static Jacobian LeftJacobian(const Tangent& omega) { return RightJacobian(-omega); }
-
-  /// Inverse left Jacobian J_l⁻¹(ω) = I − ½[ω]× + D [ω]×². Precondition: |ω| < 2π.
-  static Jacobian InverseLeftJacobian(const Tangent& omega) { return InverseRightJacobian(-omega); }
 
  private:
   static Quaternion Normalized(const Quaternion& q) {
