@@ -1,5 +1,7 @@
 #include "cheval/cheb/compress.h"
 
+#include "conditioning.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -18,9 +20,7 @@
 namespace cheval::cheb {
 namespace {
 
-// Largest condition number of a window's normal matrix accepted, as in the automatic fit: 1e10
-// keeps the coefficients accurate to ~1e-6 relative (curve.cc). Holes inside a window raise it.
-constexpr double kMaxGramCondition = 1e10;
+using internal::kMaxGramCondition;
 // A candidate fit is first checked on about this many of its samples: one beyond the tolerance
 // there rejects it without evaluating the rest (the common case for too-low degrees).
 constexpr Eigen::Index kProbeSamples = 1024;

@@ -1,5 +1,6 @@
 #include "cheval/cheb/curve.h"
 
+#include "conditioning.h"
 #include "end_caps.h"
 
 #include <algorithm>
@@ -20,10 +21,7 @@ namespace {
 // The relative tolerance below which coefficients are rounding, not signal: the chop's floor when
 // the data are noise-free.
 constexpr double kRoundingTolerance = 1e-13;
-// Largest condition number of the normal matrix accepted for the degree-choosing fit: 1e10 keeps
-// its coefficients accurate to ~1e-6 relative, far below any noise plateau the chop looks for.
-// Uneven sampling (holes inside a window) is what drives it up at a given N²/m.
-constexpr double kMaxGramCondition = 1e10;
+using internal::kMaxGramCondition;
 
 // Fits one window and, for automatic degrees, says whether it should be split instead.
 class WindowFitter {
