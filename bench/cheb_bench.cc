@@ -1,5 +1,5 @@
 // Chebyshev fitting speed. Target (velocity issue): m = 100,000 samples of a 3-vector at degree 400
-// in <= 50 ms (numpy chebfit: 16.4 s; an O(m·N) numpy prototype: 0.24 s, CHEBYSHEV.md).
+// in <= 50 ms (docs/velocity.md, "Speed").
 //   build/bench/cheb_bench
 #include <cmath>
 #include <random>
@@ -32,8 +32,8 @@ void BM_FitLeastSquares(benchmark::State& state) {
 BENCHMARK(BM_FitLeastSquares)->Args({100'000, 400})->Args({20'000, 200})->Unit(benchmark::kMillisecond);
 
 // The whole adaptive curve fit (windows, cross-validation, end refinement) of m samples at 200 Hz
-// of a 3-D motion with 0.5 mm noise, with the velocity-risk end windows on (1) or off (0): what
-// `cheval velocity` spends between reading and writing, apart from the evaluation.
+// of a 3-D motion with 0.5 mm noise: what `cheval velocity` spends between reading and writing,
+// apart from the evaluation.
 void BM_FitCurve(benchmark::State& state) {
   const auto m = static_cast<Eigen::Index>(state.range(0));
   std::mt19937_64 rng(2);
@@ -46,14 +46,12 @@ void BM_FitCurve(benchmark::State& state) {
     z.row(i) << 2.0 * std::sin(0.31 * t) + 0.3 * std::sin(1.7 * t) + noise(rng),
         1.5 * std::cos(0.23 * t) + 0.2 * std::sin(2.3 * t + 1.0) + noise(rng), 1.0 + 0.4 * std::sin(0.9 * t) + noise(rng);
   }
-  CurveOptions options;
-  options.end_velocity_risk = state.range(1) != 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(FitCurve(stamps, z, options));
+    benchmark::DoNotOptimize(FitCurve(stamps, z));
   }
   state.SetItemsProcessed(state.iterations() * m);
 }
-BENCHMARK(BM_FitCurve)->Args({100'000, 1})->Args({100'000, 0})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FitCurve)->Arg(100'000)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -2,13 +2,11 @@
 // noise 0, 0.5 mm and 2 mm, and for the real EuRoC ground truths of ../shared/data/ov_data
 // (velocity from positions against EuRoC's own velocity), the velocity RMSE over the FULL range
 // (ends included) of: cheval's automatic Chebyshev fit (default: 5-fold cross-validation per
-// window; the standardChop and universal-threshold alternatives beside it), central differences, Savitzky–Golay with
-// the best window of a grid (an oracle choice: it is told the truth), and one global Chebyshev fit
-// of fixed degree 400 (the C-ASE paper's choice for CARLA). Ratios are against the baseline
-// measured in the same run. A second table: body angular velocity from noisy orientations.
-//   build/bench/velocity_accuracy [DATA_DIR [SEEDS [FIRST_SEED [END_RISK [END_CAPS]]]]]
-// END_RISK = 1 turns on CurveOptions::end_velocity_risk for every Chebyshev column; END_CAPS = 0
-// turns off CurveOptions::end_caps (the figures before the end caps).
+// window; the standardChop alternative beside it), central differences, Savitzky–Golay with the
+// best window of a grid (an oracle choice: it is told the truth), and one global Chebyshev fit of
+// fixed degree 400 (the C-ASE paper's choice for CARLA). Ratios are against the baseline measured
+// in the same run. A second table: body angular velocity from noisy orientations.
+//   build/bench/velocity_accuracy [DATA_DIR [SEEDS [FIRST_SEED]]]
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -31,21 +29,16 @@ double Rmse(const Eigen::Matrix3Xd& estimate, const Eigen::Matrix3Xd& truth) {
 
 struct Row {
   std::string name;
-  double cheb = 0, central = 0, savgol = 0, global = 0, chop = 0, cv = 0;
+  double cheb = 0, central = 0, savgol = 0, global = 0, chop = 0;
   int savgol_window = 0;
   double inner_cheb = 0;
   double seconds = 0;
 };
 
-bool end_velocity_risk = false;  // END_RISK
-bool end_caps = true;            // END_CAPS
-
 Row Evaluate(const std::string& name, const traj::TrajectoryView& measured, const Eigen::Matrix3Xd& truth) {
   Row row;
   row.name = name;
   eval::VelocityOptions options;
-  options.curve.end_velocity_risk = end_velocity_risk;
-  options.curve.end_caps = end_caps;
   const auto start = std::chrono::steady_clock::now();
   const eval::VelocityEstimate cheb = eval::EstimateVelocity(measured, options);
   row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -54,8 +47,6 @@ Row Evaluate(const std::string& name, const traj::TrajectoryView& measured, cons
   row.inner_cheb = Rmse(cheb.velocities.middleCols(skip, n - 2 * skip), truth.middleCols(skip, n - 2 * skip));
   options.curve.degree_method = cheb::DegreeMethod::kChop;
   row.chop = Rmse(eval::EstimateVelocity(measured, options).velocities, truth);
-  options.curve.degree_method = cheb::DegreeMethod::kThreshold;
-  row.cv = Rmse(eval::EstimateVelocity(measured, options).velocities, truth);
   options.curve.degree_method = cheb::DegreeMethod::kCrossValidation;
   options.method = eval::VelocityMethod::kCentral;
   row.central = Rmse(eval::EstimateVelocity(measured, options).velocities, truth);
@@ -80,8 +71,8 @@ Row Evaluate(const std::string& name, const traj::TrajectoryView& measured, cons
 }
 
 void Print(const Row& r) {
-  std::printf("| %-28s | %10.4f | %10.4f | %10.4f | %10.4f | %10.4f | %10.4f (%3d) | %10.4f | %6.3f | %6.3f | %6.3f |\n",
-              r.name.c_str(), 1e3 * r.cheb, 1e3 * r.inner_cheb, 1e3 * r.chop, 1e3 * r.cv, 1e3 * r.central,
+  std::printf("| %-28s | %10.4f | %10.4f | %10.4f | %10.4f | %10.4f (%3d) | %10.4f | %6.3f | %6.3f | %6.3f |\n",
+              r.name.c_str(), 1e3 * r.cheb, 1e3 * r.inner_cheb, 1e3 * r.chop, 1e3 * r.central,
               1e3 * r.savgol, r.savgol_window, 1e3 * r.global, r.cheb / r.central, r.cheb / r.savgol, r.seconds);
 }
 
@@ -106,8 +97,6 @@ void AngularTable() {
       const traj::Trajectory truth = sim::SampleMotion(model, measured.stamps_ns());
       eval::VelocityOptions velocity;
       velocity.angular = true;
-      velocity.curve.end_velocity_risk = end_velocity_risk;
-      velocity.curve.end_caps = end_caps;
       const auto start = std::chrono::steady_clock::now();
       const eval::VelocityEstimate cheb = eval::EstimateVelocity(measured.View(), velocity);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -132,12 +121,10 @@ int main(int argc, char** argv) {
   const uint64_t seeds = argc > 2 ? std::stoull(argv[2]) : 1;
   // Optional: the first seed (default 1), to test on seeds the tables of docs/velocity.md do not use.
   const uint64_t first_seed = argc > 3 ? std::stoull(argv[3]) : 1;
-  end_velocity_risk = argc > 4 && std::string(argv[4]) == "1";
-  end_caps = !(argc > 5 && std::string(argv[5]) == "0");
   std::printf("velocity RMSE in mm/s, full range unless marked inner (middle 90 %%)\n\n");
-  std::printf("| %-28s | %10s | %10s | %10s | %10s | %10s | %16s | %10s | %6s | %6s | %6s |\n", "trajectory",
-              "cheval (cv)", "inner", "chop", "threshold", "central", "SG best (win)", "global 400", "/cent", "/SG", "s");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("| %-28s | %10s | %10s | %10s | %10s | %16s | %10s | %6s | %6s | %6s |\n", "trajectory", "cheval (cv)",
+              "inner", "chop", "central", "SG best (win)", "global 400", "/cent", "/SG", "s");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   for (sim::MotionKind kind :
        {sim::MotionKind::kCar, sim::MotionKind::kLegged, sim::MotionKind::kDrone, sim::MotionKind::kHandheld}) {
     for (double noise : {0.0, 0.0005, 0.002}) {

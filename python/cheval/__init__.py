@@ -110,7 +110,7 @@ def velocity(source, *, at=None, method="chebyshev", degree="auto", window=None,
     source: a path, Trajectory or mapping (positions are used; orientations with angular=True).
     at: int64 stamps (ns) or a Trajectory whose stamps to evaluate at (default: the source's own).
     method: 'chebyshev' (windowed Chebyshev least squares, differentiated), 'central' or 'savgol'.
-    degree: 'auto' (= 'cv'), 'chop', 'threshold' or an int (a fixed degree: one global fit unless
+    degree: 'auto' (= 'cv'), 'chop' or an int (a fixed degree: one global fit unless
     a window is given); window: the Chebyshev window in seconds (default adaptive);
     savgol_window: the Savitzky-Golay window in samples (odd, >= 5). angular: also body angular
     velocity from the orientations.
@@ -129,7 +129,7 @@ def fit(source, values=None, *, degree="auto", window=None, noise=None, format="
         kitti_times=None):
     """A Curve fitted to samples: fit(stamps, values) with int64 stamps (ns) and values (n, d),
     d <= 4, or fit(trajectory_or_path) for its positions. Evaluate it with curve.evaluate(stamps,
-    order). degree: 'auto' (= 'cv'), 'chop', 'threshold' or an int; window (s); noise (sigma of the
+    order). degree: 'auto' (= 'cv'), 'chop' or an int; window (s); noise (sigma of the
     samples; default estimated). See cheval.Curve.
     """
     if values is not None:

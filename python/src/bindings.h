@@ -76,10 +76,10 @@ inline std::span<const int64_t> SpanOf(const py::array_t<int64_t>& stamps) {
 /// times path), validated as the CLI validates --format / --columns / --kitti-times.
 traj::ReadOptions ReadOptionsOf(const std::string& format, const std::string& columns, const std::string& kitti_times);
 
-/// Curve options from the Python arguments of fit and velocity: degree 'auto' (= 'cv'), 'chop',
-/// 'threshold' or an int (a fixed degree; one global fit when no window is given, as `cheval
-/// velocity --degree N`), window (s) and noise sigma (None: adaptive / estimated). The library
-/// validates the values (UsageError).
+/// Curve options from the Python arguments of fit and velocity: degree 'auto' (= 'cv'), 'chop' or
+/// an int (a fixed degree; one global fit when no window is given, as `cheval velocity --degree
+/// N`), window (s) and noise sigma (None: adaptive / estimated). The library validates the values
+/// (OptionError, raised as UsageError).
 cheb::CurveOptions CurveOptionsOf(const py::object& degree, std::optional<double> window, std::optional<double> noise);
 
 void BindErrors(py::module_& m);

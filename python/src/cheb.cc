@@ -62,7 +62,7 @@ cheb::Compression CompressSamples(std::span<const int64_t> stamps, const Eigen::
                                   std::optional<double> tolerance) {
   cheb::CompressOptions options;
   options.tolerance = tolerance;
-  cheb::ValidateCompressOptions(options);
+  options.Validate();
   py::gil_scoped_release release;
   return cheb::Compress(stamps, values, options);
 }
@@ -77,17 +77,15 @@ cheb::CurveOptions CurveOptionsOf(const py::object& degree, std::optional<double
       options.degree_method = cheb::DegreeMethod::kCrossValidation;
     } else if (name == "chop") {
       options.degree_method = cheb::DegreeMethod::kChop;
-    } else if (name == "threshold") {
-      options.degree_method = cheb::DegreeMethod::kThreshold;
     } else {
-      throw UsageError(fmt::format("degree: expected 'auto', 'cv', 'chop', 'threshold' or an int, got '{}'", name));
+      throw UsageError(fmt::format("degree: expected 'auto', 'cv', 'chop' or an int, got '{}'", name));
     }
   } else if (py::isinstance<py::int_>(degree) && !py::isinstance<py::bool_>(degree)) {
     options.degree_method = cheb::DegreeMethod::kFixed;
     options.fixed_degree = degree.cast<int>();
     options.single_window = !window.has_value();  // a fixed degree alone: one global fit (as `cheval velocity`)
   } else {
-    throw UsageError("degree: expected 'auto', 'cv', 'chop', 'threshold' or an int");
+    throw UsageError("degree: expected 'auto', 'cv', 'chop' or an int");
   }
   options.window_s = window;
   options.noise_sigma = noise;
@@ -133,7 +131,7 @@ Raises ComputeError for a stamp outside the data by more than `tolerance` second
       py::arg("stamps"), py::arg("values"), py::kw_only(), py::arg("degree") = "auto", py::arg("window") = py::none(),
       py::arg("noise") = py::none(),
       R"(Fits samples `values` (n x d, d <= 4) taken at int64 `stamps` (ns, any order) with a Curve.
-degree: 'auto' (= 'cv', cross-validation per window), 'chop', 'threshold' or an int (a fixed
+degree: 'auto' (= 'cv', cross-validation per window), 'chop' or an int (a fixed
 degree: one global fit unless `window` is given); window: fixed window length in seconds
 (default adaptive); noise: the samples' noise sigma (default estimated). values is used without a
 copy when it is a Fortran-ordered float64 array, copied otherwise.)");

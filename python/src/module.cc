@@ -2,6 +2,8 @@
 // hand-over helpers, and the registration of every binding. python/cheval/__init__.py is the public
 // face over it (docs/python.md).
 #include <exception>
+#include <map>
+#include <string>
 
 #include "bindings.h"
 #include "cheval/common/error.h"
@@ -67,6 +69,11 @@ void BindErrors(py::module_& m) {
       exc.attr("column") = e.column();
       exc.attr("detail") = e.detail();
       PyErr_SetObject(g_input_error, exc.ptr());
+    } catch (const OptionError& e) {
+      // The library names the options field; these messages have always named the CLI flag.
+      static const std::map<std::string, std::string> kNames{{"window_s", "--window"}, {"tolerance", "--tolerance"}};
+      const auto name = kNames.find(e.field());
+      PyErr_SetString(g_usage_error, (name == kNames.end() ? std::string(e.what()) : e.Message(name->second)).c_str());
     } catch (const UsageError& e) {
       Raise(g_usage_error, e);
     } catch (const ComputeError& e) {

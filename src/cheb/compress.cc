@@ -1,5 +1,7 @@
 #include "cheval/cheb/compress.h"
 
+#include "conditioning.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -12,14 +14,13 @@
 #include "cheval/cheb/chebyshev.h"
 #include "cheval/cheb/fit.h"
 #include "cheval/common/error.h"
+#include "cheval/common/options.h"
 #include "cheval/traj/stamp.h"
 
 namespace cheval::cheb {
 namespace {
 
-// Largest condition number of a window's normal matrix accepted, as in the automatic fit: 1e10
-// keeps the coefficients accurate to ~1e-6 relative (curve.cc). Holes inside a window raise it.
-constexpr double kMaxGramCondition = 1e10;
+using internal::kMaxGramCondition;
 // A candidate fit is first checked on about this many of its samples: one beyond the tolerance
 // there rejects it without evaluating the rest (the common case for too-low degrees).
 constexpr Eigen::Index kProbeSamples = 1024;
@@ -287,7 +288,7 @@ TrajectoryModel FitToTolerance(const TrajectoryModel& automatic, const SortedSam
                 "not smooth at the scale of {} samples (a jump or an outlier?)",
                 noise, traj::FormatSeconds(samples.stamps[static_cast<size_t>(worst)]), options.min_window_samples);
   throw ComputeError(fmt::format(
-      "cannot meet --tolerance {} m: the most accurate model cheval can build from these samples (N^2/m <= {} and "
+      "cannot meet the tolerance of {} m: the most accurate model cheval can build from these samples (N^2/m <= {} and "
       "degree <= {} per window, windows down to {} samples) has a max error of {:.3g} m at the input samples (at {} s; "
       "RMS {:.3g} m); {}",
       tolerance, options.max_conditioning, options.max_degree, options.min_window_samples, max,
@@ -297,15 +298,16 @@ TrajectoryModel FitToTolerance(const TrajectoryModel& automatic, const SortedSam
 
 }  // namespace
 
-void ValidateCompressOptions(const CompressOptions& options) {
-  if (options.tolerance && !(*options.tolerance > 0.0 && std::isfinite(*options.tolerance))) {
-    throw UsageError(fmt::format("--tolerance must be a positive number of metres, got {}", *options.tolerance));
-  }
+void CompressOptions::Validate() const {
+  const OptionCheck check("CompressOptions");
+  check(!tolerance || (*tolerance > 0.0 && std::isfinite(*tolerance)), "tolerance",
+        "must be a positive number of metres, got {}", tolerance.value_or(0.0));
+  curve.Validate();
 }
 
 Compression Compress(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen::MatrixXd>& values,
                      const CompressOptions& options) {
-  ValidateCompressOptions(options);
+  options.Validate();
   Compression result;
   result.model = ModelFromCurve(FitCurve(stamps_ns, values, options.curve));
   result.error = MeasureReconstruction(CurveFromModel(result.model), stamps_ns, values);

@@ -1,5 +1,6 @@
 #include "cheval/cheb/curve.h"
 
+#include "conditioning.h"
 #include "end_caps.h"
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 
 #include "cheval/cheb/degree.h"
 #include "cheval/common/error.h"
+#include "cheval/common/options.h"
 
 namespace cheval::cheb {
 namespace {
@@ -19,28 +21,7 @@ namespace {
 // The relative tolerance below which coefficients are rounding, not signal: the chop's floor when
 // the data are noise-free.
 constexpr double kRoundingTolerance = 1e-13;
-// Largest condition number of the normal matrix accepted for the degree-choosing fit: 1e10 keeps
-// its coefficients accurate to ~1e-6 relative, far below any noise plateau the chop looks for.
-// Uneven sampling (holes inside a window) is what drives it up at a given N²/m.
-constexpr double kMaxGramCondition = 1e10;
-
-void ValidateOptions(const CurveOptions& o) {
-  if (o.degree_method == DegreeMethod::kFixed && o.fixed_degree < 0) {
-    throw UsageError(fmt::format("--degree must be a non-negative integer, got {}", o.fixed_degree));
-  }
-  if (o.window_s && !(*o.window_s > 0.0 && std::isfinite(*o.window_s))) {
-    throw UsageError(fmt::format("--window must be a positive number of seconds, got {}", *o.window_s));
-  }
-  if (!(o.max_conditioning > 0.0)) throw UsageError("max_conditioning must be positive");
-  if (o.max_degree < 1) throw UsageError("max_degree must be at least 1");
-  if (!(o.overlap >= 0.0 && o.overlap <= 1.0)) throw UsageError("overlap must be in [0, 1]");
-  if (!(o.gap_factor > 1.0)) throw UsageError("gap_factor must be greater than 1");
-  if (!(o.min_gap_s >= 0.0)) throw UsageError("min_gap_s must be non-negative");
-  if (o.noise_sigma && !(*o.noise_sigma >= 0.0 && std::isfinite(*o.noise_sigma))) {
-    throw UsageError(fmt::format("--noise must be a non-negative number, got {}", *o.noise_sigma));
-  }
-  if (o.min_window_samples < 2) throw UsageError("min_window_samples must be at least 2");
-}
+using internal::kMaxGramCondition;
 
 // Fits one window and, for automatic degrees, says whether it should be split instead.
 class WindowFitter {
@@ -78,7 +59,7 @@ class WindowFitter {
       if (options_.fixed_degree + 1 > distinct) {
         throw ComputeError(fmt::format(
             "degree {} needs at least {} distinct stamps per window, but the window {:.6f} s..{:.6f} s has {}; "
-            "use a smaller --degree or a longer --window",
+            "use a smaller CurveOptions::fixed_degree or a longer window_s",
             options_.fixed_degree, options_.fixed_degree + 1, window.fit_begin, window.fit_end, distinct));
       }
       std::fill(window.degrees.begin(), window.degrees.end(), options_.fixed_degree);
@@ -95,7 +76,7 @@ class WindowFitter {
     // recording) is usually split: a subsample with N²/m = 2 (well conditioned, coefficient noise
     // still white) tells that at a fraction of the cost. Only its "unresolved" is trusted: a
     // subsample's noise plateau is higher, so it resolves no less than all the samples would.
-    if (may_split && options_.degree_method != DegreeMethod::kThreshold) {
+    if (may_split) {
       const Eigen::Index stride = m / std::max<Eigen::Index>(Eigen::Index{top} * top / 2, 16 * (top + 1));
       if (stride >= 2 && !ResolvedOnSubsample(tw, zw, stride, top, interval)) return std::nullopt;
     }
@@ -133,31 +114,15 @@ class WindowFitter {
     }
     const Eigen::MatrixXd high = cholesky->Solve(top, probe.rhs);
     window.coefficient_magnitudes = high.cwiseAbs();
-    bool resolved = true;
-    if (options_.degree_method == DegreeMethod::kThreshold) {
-      const Eigen::VectorXd variance_factors = cholesky->VarianceFactors(top);
-      const double universal = std::sqrt(2.0 * std::log(static_cast<double>(top + 1)));
-      for (int c = 0; c < d; ++c) {
-        int significant = 0;
-        for (int k = 1; k <= top; ++k) {
-          const double threshold = universal * sigma_[c] * std::sqrt(variance_factors[k]);
-          if (std::abs(high(k, c)) > threshold) significant = k;
-        }
-        window.degrees[c] = significant;
-        // Significant coefficients up to the top: the motion is not resolved at this degree.
-        if (top >= 8 && significant > (top * 9) / 10) resolved = false;
-      }
-    } else {
-      // standardChop decides whether the window resolves the motion (its coefficients reach the
-      // noise plateau); it also picks the degree for kChop. Cross-validation picks the degree of a
-      // resolved window for kCrossValidation: held-out error alone cannot tell an unresolved window
-      // (every candidate underfits) from a resolved one.
-      resolved = ChopDegrees(high, m, &window.degrees);
-      // The chop looks for a plateau by shape, which a short noisy window can hide: when the top
-      // third of the coefficients is statistically pure noise, the window is resolved anyway.
-      if (!resolved) resolved = TailIsNoise(high, *cholesky);
-      if (cross_validate && (resolved || !may_split)) window.degrees = CrossValidatedDegrees(*folds, top);
-    }
+    // standardChop decides whether the window resolves the motion (its coefficients reach the noise
+    // plateau); it also picks the degree for kChop. Cross-validation picks the degree of a resolved
+    // window for kCrossValidation: held-out error alone cannot tell an unresolved window (every
+    // candidate underfits) from a resolved one.
+    bool resolved = ChopDegrees(high, m, &window.degrees);
+    // The chop looks for a plateau by shape, which a short noisy window can hide: when the top third
+    // of the coefficients is statistically pure noise, the window is resolved anyway.
+    if (!resolved) resolved = TailIsNoise(high, *cholesky);
+    if (cross_validate && (resolved || !may_split)) window.degrees = CrossValidatedDegrees(*folds, top);
     if (!resolved && may_split) return std::nullopt;
 
     // Each coordinate at its own degree: leading blocks of the same factorisation.
@@ -230,101 +195,6 @@ class WindowFitter {
     return grid;
   }
 
-  // The estimated Σ over the core's samples of the velocity's mean squared error (per second²) of
-  // a fitted window; with `reduce`, each coordinate first gets the degree of least estimated error
-  // among its cross-validated degree R and the grid values below it (for a segment's end windows:
-  // cross-validation chooses degrees for the positions, while at an end the derivative's variance
-  // grows like N⁴/m, so the velocity there wants a lower degree).
-  //
-  // With v_N the fitted velocity of degree N at the core's samples (same samples and normal
-  // equations for every N <= R), the fits are nested projections: Cov(v_N, v_R) = Var(v_N), so
-  //   E Σ (v_N − v_R)² = Σ (b_N − b_R)² + Σ Var(v_R) − Σ Var(v_N)       (b the biases)
-  // and J(N) = Σ (v_N − v_R)² − Σ Var(v_R) + 2 Σ Var(v_N) is an unbiased estimate of Σ MSE(v_N)
-  // when b_R is negligible (Mallows' C_p for the derivative; J(R) = Σ Var(v_R)), with
-  // Var(v_N(t)) = σ²·d_N(t)ᵀG_N⁻¹d_N(t)·(2/L)², d_N(t) the row of T_k'(x), σ the noise estimate.
-  // Including −Σ Var(v_R) makes J comparable between windows covering the same samples.
-  double CoreVelocityRisk(CurveWindow* window, bool reduce) const {
-    const auto first = std::lower_bound(t_.data(), t_.data() + t_.size(), window->fit_begin) - t_.data();
-    const auto last = std::upper_bound(t_.data(), t_.data() + t_.size(), window->fit_end) - t_.data();
-    const auto core_first = std::lower_bound(t_.data(), t_.data() + t_.size(), window->core_begin) - t_.data();
-    const auto core_last = std::upper_bound(t_.data(), t_.data() + t_.size(), window->core_end) - t_.data();
-    const int top = *std::max_element(window->degrees.begin(), window->degrees.end());
-    if (core_last <= core_first) return 0.0;
-    const Interval& interval = window->series.interval;
-    const NormalEquations normal =
-        BuildNormalEquationsUnchecked(t_.segment(first, last - first), z_.middleRows(first, last - first), top, interval);
-    std::optional<NestedCholesky> cholesky;
-    try {
-      cholesky.emplace(normal, top);
-    } catch (const ComputeError&) {
-      return std::numeric_limits<double>::infinity();
-    }
-    // H = Σ_i d(t_i)d(t_i)ᵀ over the core's samples, d(t) = (T_k'(x))_k = (k·U_{k−1}(x))_k: then
-    // Σ_i (v_N − v_R)(t_i)² = (c_N − c_R)ᵀH(c_N − c_R) (c_N padded with zeros) and
-    // Σ_i d_iᵀG_N⁻¹d_i = Σ (G_N⁻¹ ∘ H_N), so no candidate is evaluated sample by sample.
-    Eigen::MatrixXd h = Eigen::MatrixXd::Zero(top + 1, top + 1);
-    {
-      Eigen::VectorXd d(top + 1);
-      for (Eigen::Index i = core_first; i < core_last; ++i) {
-        const double x = interval.ToUnit(t_[i]);
-        double u_prev = 0.0, u = 1.0;  // U_{-1}, U_0
-        d[0] = 0.0;
-        for (int k = 1; k <= top; ++k) {
-          d[k] = k * u;
-          const double next = 2.0 * x * u - u_prev;
-          u_prev = u;
-          u = next;
-        }
-        h.selfadjointView<Eigen::Lower>().rankUpdate(d);
-      }
-      h.triangularView<Eigen::StrictlyUpper>() = h.transpose();
-    }
-    const double scale = interval.DerivativeScale();
-    const std::vector<int> original = window->degrees;
-    bool changed = false;
-    double risk = 0.0;
-    for (size_t c = 0; c < window->degrees.size(); ++c) {
-      const int reference = window->degrees[c];
-      const auto col = static_cast<Eigen::Index>(c);
-      const Eigen::VectorXd c_reference = cholesky->Solve(reference, normal.rhs.col(col));
-      auto variance_sum = [&](int n) {
-        const Eigen::MatrixXd g_inverse = cholesky->Solve(n, Eigen::MatrixXd::Identity(n + 1, n + 1));
-        return sigma_[col] * sigma_[col] * g_inverse.cwiseProduct(h.topLeftCorner(n + 1, n + 1)).sum();
-      };
-      const double reference_variance = variance_sum(reference);
-      double best = reference_variance;
-      int best_degree = reference;
-      if (reduce && reference >= 3) {
-        for (int n : DegreeGrid(reference)) {
-          if (n >= reference) continue;
-          Eigen::VectorXd difference = -c_reference;
-          difference.head(n + 1) += cholesky->Solve(n, normal.rhs.col(col));
-          const auto hr = h.topLeftCorner(reference + 1, reference + 1);
-          const double j = difference.dot(hr * difference) - reference_variance + 2.0 * variance_sum(n);
-          if (j < best) best = j, best_degree = n;
-        }
-      }
-      risk += best * scale * scale;
-      if (best_degree != reference) {
-        window->degrees[c] = best_degree;
-        changed = true;
-      }
-    }
-    if (!changed) return risk;
-    const int degree = *std::max_element(window->degrees.begin(), window->degrees.end());
-    Eigen::MatrixXd coefficients = Eigen::MatrixXd::Zero(degree + 1, static_cast<Eigen::Index>(window->degrees.size()));
-    for (size_t c = 0; c < window->degrees.size(); ++c) {
-      const auto col = static_cast<Eigen::Index>(c);
-      const int n = window->degrees[c];
-      // Coordinates that keep their degree keep their coefficients.
-      coefficients.col(col).head(n + 1) = n == original[c] ? window->series.coefficients.col(col).head(n + 1)
-                                                           : cholesky->Solve(n, normal.rhs.col(col));
-    }
-    window->series.coefficients = std::move(coefficients);
-    Finish(window);
-    return risk;
-  }
-
   // Derivative coefficients of a fitted window.
   static void Finish(CurveWindow* window) {
     window->first_derivative = DerivativeCoefficients(window->series.coefficients);
@@ -346,7 +216,7 @@ class WindowFitter {
       const double scale = coefficients.cwiseAbs().maxCoeff();
       (*degrees)[c] = 0;
       if (scale == 0.0) continue;  // a constant coordinate: degree 0
-      // Noise level of a coefficient of m equispaced samples: σ·sqrt(2/m) (CHEBYSHEV.md).
+      // Noise level of a coefficient of m equispaced samples: σ·sqrt(2/m) (docs/velocity.md, "Formulas").
       const double noise = sigma_[c] * std::sqrt(2.0 / static_cast<double>(m));
       const double tol = std::clamp(noise / scale, kRoundingTolerance, 0.5);
       const int keep = StandardChop(coefficients, tol);
@@ -521,37 +391,6 @@ void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegme
       }
     }
   }
-  if (!options.end_velocity_risk) return;
-  // Then, by the velocity itself: the end window is halved while the estimated velocity error over
-  // its core (WindowFitter::CoreVelocityRisk) is lower for its two halves (the outer one at its
-  // degrees of least risk, the inner one as cross-validated) than for the window at its degrees of
-  // least risk; the final end windows keep those degrees.
-  for (const bool front : {true, false}) {
-    while (true) {
-      auto& windows = segment.windows;
-      const CurveWindow& end = front ? windows.front() : windows.back();
-      if (samples_in(end.core_begin, end.core_end) < 2 * options.min_window_samples) break;
-      const double a = end.core_begin, b = end.core_end, middle = 0.5 * (a + b);
-      CurveWindow whole = end;
-      const double risk_whole = fitter.CoreVelocityRisk(&whole, true);
-      CurveWindow outer = *fitter.Fit(front ? a : middle, front ? middle : b, segment.begin, segment.end, false);
-      CurveWindow inner = *fitter.Fit(front ? middle : a, front ? b : middle, segment.begin, segment.end, false);
-      CurveWindow outer_reduced = outer;
-      const double risk_split = fitter.CoreVelocityRisk(&outer_reduced, true) + fitter.CoreVelocityRisk(&inner, false);
-      if (!(risk_split < risk_whole)) break;
-      if (front) {
-        windows.erase(windows.begin());
-        windows.insert(windows.begin(), std::move(inner));
-        windows.insert(windows.begin(), std::move(outer));
-      } else {
-        windows.pop_back();
-        windows.push_back(std::move(inner));
-        windows.push_back(std::move(outer));
-      }
-    }
-  }
-  fitter.CoreVelocityRisk(&segment.windows.front(), true);
-  if (segment.windows.size() > 1) fitter.CoreVelocityRisk(&segment.windows.back(), true);
 }
 
 // Up to 4 coordinates, on the stack: evaluation allocates nothing.
@@ -592,9 +431,26 @@ void Smoothstep(double u, double* s, double* ds, double* dds) {
   *dds = 60.0 * u * (1.0 - u) * (1.0 - 2.0 * u);
 }
 
+void CurveOptions::Validate() const {
+  const OptionCheck check("CurveOptions");
+  check(degree_method != DegreeMethod::kFixed || fixed_degree >= 0, "fixed_degree",
+        "must be a non-negative integer, got {}", fixed_degree);
+  check(!window_s || (*window_s > 0.0 && std::isfinite(*window_s)), "window_s",
+        "must be a positive number of seconds, got {}", window_s.value_or(0.0));
+  check(max_conditioning > 0.0, "max_conditioning", "must be positive, got {}", max_conditioning);
+  check(max_degree >= 1, "max_degree", "must be at least 1, got {}", max_degree);
+  check(min_window_samples >= 2, "min_window_samples", "must be at least 2, got {}", min_window_samples);
+  check(overlap >= 0.0 && overlap <= 1.0, "overlap", "must be in [0, 1], got {}", overlap);
+  check(gap_factor > 1.0, "gap_factor", "must be greater than 1, got {}", gap_factor);
+  check(min_gap_s >= 0.0, "min_gap_s", "must be non-negative, got {}", min_gap_s);
+  check(!noise_sigma || (*noise_sigma >= 0.0 && std::isfinite(*noise_sigma)), "noise_sigma",
+        "must be a non-negative number, got {}", noise_sigma.value_or(0.0));
+  check(end_degree >= 0, "end_degree", "must be non-negative (0: no end refinement), got {}", end_degree);
+}
+
 Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen::MatrixXd>& values,
                const CurveOptions& options) {
-  ValidateOptions(options);
+  options.Validate();
   const auto m = static_cast<Eigen::Index>(stamps_ns.size());
   if (values.rows() != m) throw std::invalid_argument("FitCurve: stamps and values differ in length");
   if (values.cols() < 1 || values.cols() > 4) throw std::invalid_argument("FitCurve: 1..4 coordinates");

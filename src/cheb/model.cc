@@ -8,6 +8,7 @@
 
 #include "cheval/cheb/chebyshev.h"
 #include "cheval/common/error.h"
+#include "cheval/common/options.h"
 #include "cheval/traj/stamp.h"
 
 namespace cheval::cheb {
@@ -148,18 +149,14 @@ void CheckModelCovers(const TrajectoryModel& model, std::span<const int64_t> sta
 }
 
 std::vector<int64_t> ModelGridStamps(const TrajectoryModel& model, double rate_hz) {
-  if (!(rate_hz > 0.0 && std::isfinite(rate_hz))) {
-    throw UsageError(fmt::format("--rate must be a positive number of Hz, got {}", rate_hz));
-  }
+  const OptionCheck check("ModelGridStamps");
+  check(rate_hz > 0.0 && std::isfinite(rate_hz), "rate_hz", "must be a positive number of Hz, got {}", rate_hz);
   if (model.segments.empty()) throw ComputeError("the model has no segments");
   constexpr double kMaxStamps = 1e8;
   const double span_s = OffsetSeconds(model.segments.back().last_ns, model.origin_ns);
   const double count = std::floor(span_s * rate_hz) + 1.0;
-  if (!(count <= kMaxStamps)) {
-    throw UsageError(
-        fmt::format("--rate {} Hz over the model's {:.3f} s gives {:.4g} stamps; at most {:.0f} are allowed", rate_hz,
-                    span_s, count, kMaxStamps));
-  }
+  check(count <= kMaxStamps, "rate_hz", "must give at most {:.0f} stamps over the model's {:.3f} s; {} Hz gives {:.4g}",
+        kMaxStamps, span_s, rate_hz, count);
   std::vector<int64_t> stamps;
   auto segment = model.segments.begin();
   for (int64_t k = 0; k < static_cast<int64_t>(count) && segment != model.segments.end(); ++k) {

@@ -33,7 +33,7 @@ TEST(ChebyshevPoints, DescendingSymmetricWithExactEnds) {
 
 TEST(DifferentiationMatrix, NegativeSumTrickAtDegree1024) {
   const Eigen::MatrixXd D = DifferentiationMatrix(1024);
-  // CHEBYSHEV.md: textbook diagonal 1.2e-5, negative-sum trick ~4e-10 (entries reach ~7e5).
+  // docs/velocity.md "Formulas": textbook diagonal 1.2e-5, negative-sum trick ~4e-10 (entries reach ~7e5).
   EXPECT_LE((D * Eigen::VectorXd::Ones(1025)).cwiseAbs().maxCoeff(), 1e-9);
 }
 

@@ -200,7 +200,7 @@ TEST(Compress, ToleranceBelowTheNoiseIsAnErrorThatSaysWhatCanBeReached) {
     FAIL() << "a tolerance of 2σ cannot be met";
   } catch (const ComputeError& e) {
     const std::string message = e.what();
-    EXPECT_EQ(message.rfind("cannot meet --tolerance 0.001 m: the most accurate model cheval can build from these "
+    EXPECT_EQ(message.rfind("cannot meet the tolerance of 0.001 m: the most accurate model cheval can build from these "
                             "samples (N^2/m <= 8 and degree <= 400 per window, windows down to 24 samples) has a max "
                             "error of 0.00",
                             0),
@@ -233,9 +233,20 @@ TEST(Compress, TooFewSamplesEqualStampsAndBadTolerances) {
     try {
       Compress(std::vector<int64_t>{1, 2, 3}, three, options);
       FAIL() << bad;
-    } catch (const UsageError& e) {
-      EXPECT_EQ(std::string(e.what()), std::string("--tolerance must be a positive number of metres, got ") + text);
+    } catch (const OptionError& e) {
+      EXPECT_EQ(e.field(), "tolerance");
+      EXPECT_EQ(std::string(e.what()),
+                std::string("CompressOptions::tolerance must be a positive number of metres, got ") + text);
     }
+  }
+  // The curve options are validated too, before any work.
+  CompressOptions bad_curve;
+  bad_curve.curve.min_window_samples = 1;
+  try {
+    Compress(std::vector<int64_t>{1, 2, 3}, three, bad_curve);
+    FAIL();
+  } catch (const OptionError& e) {
+    EXPECT_STREQ(e.what(), "CurveOptions::min_window_samples must be at least 2, got 1");
   }
   // Three samples are interpolated: any tolerance is met.
   CompressOptions options;
@@ -448,17 +459,17 @@ TEST(ModelSampling, GridSkipsGapsAndCoverageNamesTheStamp) {
     try {
       ModelGridStamps(model, bad);
       ADD_FAILURE() << bad;
-    } catch (const UsageError& e) {
-      EXPECT_EQ(std::string(e.what()), std::string("--rate must be a positive number of Hz, got ") + text);
+    } catch (const OptionError& e) {
+      EXPECT_EQ(std::string(e.what()), std::string("ModelGridStamps::rate_hz must be a positive number of Hz, got ") + text);
     }
   }
   try {
     ModelGridStamps(model, 1e9);
     ADD_FAILURE();
-  } catch (const UsageError& e) {
+  } catch (const OptionError& e) {
     EXPECT_STREQ(e.what(),
-                 "--rate 1000000000 Hz over the model's 4.000 s gives 4e+09 stamps; at most 100000000 are "
-                 "allowed");
+                 "ModelGridStamps::rate_hz must give at most 100000000 stamps over the model's 4.000 s; 1000000000 Hz "
+                 "gives 4e+09");
   }
 }
 

@@ -133,7 +133,7 @@ TEST_F(CompressCliTest, ToleranceIsMetOrRefusedWithNoFile) {
   // 0.5 mm is σ: most samples lie farther than that from any smooth path.
   const RunResult refused = Cheval("compress " + Path("m.txt") + " -o " + Path("no.json") + " --tolerance 0.0005");
   EXPECT_EQ(refused.exit_code, 3);
-  EXPECT_EQ(refused.err.rfind("cheval: error: cannot meet --tolerance 0.0005 m: the most accurate model cheval can "
+  EXPECT_EQ(refused.err.rfind("cheval: error: cannot meet the tolerance of 0.0005 m: the most accurate model cheval can "
                               "build from these samples (N^2/m <= 8 and degree <= 400 per window, windows down to 24 "
                               "samples) has a max error of ",
                               0),

@@ -77,7 +77,7 @@ void RegisterCompress(CLI::App& app, Action* action) {
       const auto start = std::chrono::steady_clock::now();
       cheb::CompressOptions options;
       options.tolerance = flags->tolerance;
-      cheb::ValidateCompressOptions(options);  // before any work
+      options.Validate();  // before any work
       const traj::Trajectory trajectory = traj::ReadTrajectory(flags->input, flags->format.ToReadOptions());
       const traj::TrajectoryView view = trajectory.View();
       if (!view.has_stamps()) throw ComputeError("compress needs stamps; give the KITTI times with --kitti-times");

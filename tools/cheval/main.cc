@@ -2,6 +2,8 @@
 // the library's typed errors to the documented exit codes (docs/cli.md).
 #include <cstdio>
 #include <exception>
+#include <map>
+#include <string>
 
 #include <fmt/format.h>
 
@@ -55,6 +57,14 @@ int main(int argc, char** argv) {
     return static_cast<int>(ExitCode::kOk);
   } catch (const cheval::InputError& e) {
     return fail(ExitCode::kInput, e.what());
+  } catch (const cheval::OptionError& e) {
+    // The library names the options field; the flag that sets it (fields without a flag keep the
+    // library's spelling).
+    static const std::map<std::string, std::string> kFlags{
+        {"window_s", "--window"}, {"fixed_degree", "--degree"}, {"tolerance", "--tolerance"}, {"rate_hz", "--rate"}};
+    const auto flag = kFlags.find(e.field());
+    return fail(ExitCode::kUsage,
+                fmt::format("cheval: error: {}", flag == kFlags.end() ? std::string(e.what()) : e.Message(flag->second)));
   } catch (const cheval::UsageError& e) {
     return fail(ExitCode::kUsage, fmt::format("cheval: error: {}", e.what()));
   } catch (const cheval::ComputeError& e) {

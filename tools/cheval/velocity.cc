@@ -38,14 +38,12 @@ eval::VelocityOptions ToOptions(const VelocityFlags& flags, const traj::Trajecto
     options.curve.degree_method = cheb::DegreeMethod::kCrossValidation;
   } else if (flags.degree == "chop") {
     options.curve.degree_method = cheb::DegreeMethod::kChop;
-  } else if (flags.degree == "threshold") {
-    options.curve.degree_method = cheb::DegreeMethod::kThreshold;
   } else {
     int degree = -1;
     const auto [end, ec] = std::from_chars(flags.degree.data(), flags.degree.data() + flags.degree.size(), degree);
     if (ec != std::errc() || end != flags.degree.data() + flags.degree.size() || degree < 0) {
       throw UsageError(
-          fmt::format("--degree: expected auto, cv, chop, threshold or a non-negative integer, got '{}'", flags.degree));
+          fmt::format("--degree: expected auto, cv, chop or a non-negative integer, got '{}'", flags.degree));
     }
     options.curve.degree_method = cheb::DegreeMethod::kFixed;
     options.curve.fixed_degree = degree;
@@ -124,7 +122,7 @@ void RegisterVelocity(CLI::App& app, Action* action) {
       ->capture_default_str();
   command->add_option("--degree", flags->degree,
                       "chebyshev: auto = cv (5-fold cross-validation per window), chop (standardChop at the "
-                      "estimated noise level), threshold (universal threshold on the coefficients) or a fixed degree")
+                      "estimated noise level) or a fixed degree")
       ->capture_default_str();
   command->add_option("--window", flags->window_s,
                       "chebyshev: fixed window length in seconds (default: adaptive); savgol: window in seconds "

@@ -14,7 +14,7 @@
 
 namespace cheval::cheb {
 
-/// Options of Compress.
+/// Options of Compress; Validate() is called by Compress.
 struct CompressOptions {
   /// The automatic fit (FitCurve) and the limits of the tolerance fit (max_conditioning,
   /// max_degree, min_window_samples, overlap); the defaults need no tuning.
@@ -24,6 +24,11 @@ struct CompressOptions {
   /// model spends: the result is the smallest model found within it, coarser than the automatic
   /// fit when the tolerance is loose, finer when it is tight. nullopt: the automatic fit.
   std::optional<double> tolerance;
+
+  /// Throws OptionError naming the first field out of range: tolerance, when given, not positive
+  /// and finite ("CompressOptions::tolerance must be a positive number of metres, got nan"); then
+  /// curve.Validate().
+  void Validate() const;
 };
 
 /// A model and what it costs and achieves.
@@ -42,14 +47,10 @@ struct Compression {
   bool automatic = true;
 };
 
-/// Throws UsageError ("--tolerance must be a positive number of metres, got nan") unless the
-/// tolerance, when given, is positive and finite.
-void ValidateCompressOptions(const CompressOptions& options);
-
 /// Fits `values` (m x d; row i sampled at stamps_ns[i], any order) with FitCurve and stores the
 /// result as a model. With a tolerance M, each gap-free segment (as FitCurve splits them) is
 /// covered top-down instead: a window (first the whole segment) is fitted by least squares at the
-/// highest degree its samples allow — N²/m <= curve.max_conditioning (8), <= curve.max_degree,
+/// highest degree its samples allow — N²/m <= curve.max_conditioning, <= curve.max_degree,
 /// below the number of distinct stamps, well-conditioned normal equations — and if that fit is
 /// within M at every sample where the curve may use the window (its core and half its overlap),
 /// the window keeps the smallest degrees within M (per coordinate by bisection, then the
@@ -58,7 +59,7 @@ void ValidateCompressOptions(const CompressOptions& options);
 /// curve.min_window_samples samples per core. Blending windows that are within M keeps the curve
 /// within M. The automatic model is kept instead when it meets M with fewer numbers.
 ///
-/// Throws UsageError for a tolerance that is not a positive finite number; ComputeError when the
+/// Throws OptionError for bad options (CompressOptions::Validate); ComputeError when the
 /// data cannot be fitted (FitCurve: fewer than 2 samples, all stamps equal) or M cannot be met,
 /// giving the max and RMS error of the most accurate model found and the estimated noise.
 Compression Compress(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen::MatrixXd>& values,

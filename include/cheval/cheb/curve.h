@@ -19,19 +19,16 @@ namespace cheval::cheb {
 /// How the degree of each window is chosen.
 enum class DegreeMethod {
   /// 5-fold cross-validation over a geometric grid of degrees, per coordinate (default: the most
-  /// accurate velocity on every synthetic kind of bench/velocity_accuracy, docs/velocity.md).
+  /// accurate velocity of the automatic rules, docs/velocity.md "Accuracy").
   kCrossValidation,
   /// Chebfun's standardChop on a high-degree fit, tolerance σ·sqrt(2/m) relative to the largest
-  /// varying coefficient, σ the (estimated) noise.
+  /// varying coefficient, σ the (estimated) noise: about half the time of cross-validation, with a
+  /// larger velocity error on noisy data (docs/velocity.md "Accuracy", column "chop").
   kChop,
-  /// The last coefficient of a high-degree fit that stands out of the noise: |c_k| above the
-  /// universal threshold σ_k·sqrt(2 ln K) (Donoho & Johnstone 1994), σ_k = σ·sqrt((G⁻¹)_kk) the
-  /// coefficient's own noise level and K the number of coefficients.
-  kThreshold,
   kFixed,  ///< the given degree in every window
 };
 
-/// Options of FitCurve; defaults need no tuning.
+/// Options of FitCurve; defaults need no tuning. Validate() is called by FitCurve.
 struct CurveOptions {
   DegreeMethod degree_method = DegreeMethod::kCrossValidation;
   /// kFixed: the degree. With a single window this is the classic global fit.
@@ -39,7 +36,7 @@ struct CurveOptions {
   /// Fixed window length (s); nullopt = adaptive: windows are halved until their series resolve.
   std::optional<double> window_s;
   /// Upper bound of N²/m in a window: beyond it equispaced least squares is ill-conditioned
-  /// (CHEBYSHEV.md: N²/m = 8 -> condition ~15, 32 -> 2e5).
+  /// (docs/velocity.md "Formulas": N²/m = 8 -> condition ~15, 32 -> 2e5).
   double max_conditioning = 8.0;
   /// Largest degree tried in a window.
   int max_degree = 400;
@@ -57,29 +54,26 @@ struct CurveOptions {
   /// The derivative of a least-squares polynomial is noisiest at the ends of its interval, and
   /// more so the higher its degree (the variance at an end grows like N⁴/m). The first and last
   /// window of every segment are therefore halved until their degree is at most end_degree (or
-  /// they reach min_window_samples): a graded mesh towards the ends. 0 disables it. 20 had the
-  /// best geometric-mean full-range error over the synthetic kinds of bench/velocity_accuracy
-  /// among 0, 10 and 20 (docs/velocity.md).
+  /// they reach min_window_samples): a graded mesh towards the ends. 0 disables it. The default 20
+  /// gives the lowest full-range velocity error over the synthetic kinds of docs/velocity.md.
   int end_degree = 20;
-  /// After that, choose the end windows by their velocity: an end window is halved while the
-  /// estimated velocity mean squared error over its core (Mallows' C_p for the derivative against
-  /// the cross-validated fit, from the known noise of a least-squares fit) is lower for the halves,
-  /// and each coordinate of the final end windows keeps the degree of least estimated velocity
-  /// error (at most the cross-validated one). Cross-validation measures position error, which does
-  /// not see the N⁴/m growth of the derivative's variance at an end. Needs end_degree > 0. Off by
-  /// default: over 15 simulator seeds it helped the legged kind (more seeds within Savitzky–Golay's
-  /// error) but made other rows worse by up to ~25 % (docs/velocity.md, "Ends by velocity risk").
-  bool end_velocity_risk = false;
   /// Then give each end of a segment a short low-degree "cap" where that is estimated to lower the
   /// velocity error: the cap's length, blending boundary and degrees are chosen by one-sided fits
   /// at artificial ends inside the segment, checked against the curve's interior velocity there
   /// (docs/velocity.md, "End caps"). Adaptive windows only (not with window_s, single_window or a
-  /// fixed degree, which ask for a literal fit); segments need at least three windows.
+  /// fixed degree, which ask for a literal fit); segments need at least three windows. false keeps
+  /// the end windows' own polynomials.
   bool end_caps = true;
   /// Fit a single window over each gap-free segment (no splitting), e.g. to reproduce a global fit.
   bool single_window = false;
   /// Told "fitting windows" with the samples fitted so far, as windows are accepted (may be empty).
   ProgressFn progress;
+
+  /// Throws OptionError naming the first field out of range: fixed_degree < 0 (with kFixed),
+  /// window_s not positive and finite, max_conditioning <= 0, max_degree < 1,
+  /// min_window_samples < 2, overlap outside [0, 1], gap_factor <= 1, min_gap_s < 0, noise_sigma
+  /// negative or not finite, end_degree < 0.
+  void Validate() const;
 };
 
 /// One window: its core [core_begin, core_end] (seconds from the curve's origin), the samples used
@@ -166,8 +160,8 @@ void Smoothstep(double u, double* s, double* ds, double* dds);
 
 /// Fits `values` (m x d, d <= 4; row i sampled at stamps_ns[i]) with a Curve. Stamps need not be
 /// sorted or unique (samples are sorted by stamp; equal stamps are averaged by the least squares).
-/// Throws ComputeError for fewer than 2 samples, all-equal stamps, or a fixed degree above what a
-/// window's samples support; UsageError for bad options.
+/// Throws OptionError for bad options (CurveOptions::Validate); ComputeError for fewer than 2
+/// samples, all-equal stamps, or a fixed degree above what a window's samples support.
 Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen::MatrixXd>& values,
                const CurveOptions& options = {});
 

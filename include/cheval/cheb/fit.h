@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// Weighted least-squares fitting of vector samples by a Chebyshev polynomial, in O(m·N) without
-/// forming the m x (N + 1) design matrix (CHEBYSHEV.md, "Least-squares fit of noisy samples").
+/// forming the m x (N + 1) design matrix (docs/velocity.md, "Formulas").
 
 #include <Eigen/Core>
 

@@ -102,8 +102,8 @@ void CheckModelCovers(const TrajectoryModel& model, std::span<const int64_t> sta
 
 /// The stamps origin_ns + round(k·1e9/rate_hz) ns, k = 0, 1, ..., that lie inside a segment (from
 /// the first modelled stamp to the last; stamps in gaps between segments are left out). Throws
-/// UsageError ("--rate ...") unless rate_hz is positive and finite and the grid has at most 1e8
-/// stamps over the model's span.
+/// OptionError ("ModelGridStamps::rate_hz must be ...") unless rate_hz is positive and finite and
+/// the grid has at most 1e8 stamps over the model's span.
 std::vector<int64_t> ModelGridStamps(const TrajectoryModel& model, double rate_hz);
 
 /// The model as JSON text (docs/compress.md): `"format": "cheval-trajectory-model"`, `"version": 1`.

@@ -1,0 +1,148 @@
+#include "cheval/cheb/degree.h"
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "cheval/cheb/fit.h"
+
+namespace cheval::cheb {
+namespace {
+
+// The chop's tolerance for noise-free data (curve.cc's rounding floor).
+constexpr double kRounding = 1e-13;
+
+TEST(StandardChop, FindsTheEndOfAGeometricSeries) {
+  // |c_k| = 10^(-k/2) down to 1e-15 (k = 30), then a rounding plateau: resolved at about degree 30.
+  Eigen::VectorXd c(60);
+  for (int k = 0; k < 60; ++k) c[k] = k <= 30 ? std::pow(10.0, -k / 2.0) : 1e-15 * (1.0 + 0.3 * std::sin(k));
+  const int keep = StandardChop(c, kRounding);
+  EXPECT_GE(keep, 24);
+  EXPECT_LE(keep, 31);
+  // Without a plateau (still decaying at the end) the series is not resolved: all are kept.
+  Eigen::VectorXd decaying(40);
+  for (int k = 0; k < 40; ++k) decaying[k] = std::pow(10.0, -k / 10.0);
+  EXPECT_EQ(StandardChop(decaying, kRounding), 40);
+}
+
+// A polynomial of degree p has exactly p + 1 nonzero coefficients; the zeros after them are the
+// plateau, and the chop keeps exactly the p + 1 (worked by hand for p = 3, tol = 1e-13: the plateau
+// starts at j = 5, the envelope there is set to tol^(7/6), and log10(envelope) + tilt is smallest
+// at i = 5, so 4 are kept).
+TEST(StandardChop, KeepsExactlyTheCoefficientsOfAPolynomial) {
+  for (int p : {1, 3, 7, 20}) {
+    Eigen::VectorXd c = Eigen::VectorXd::Zero(60);
+    for (int k = 0; k <= p; ++k) c[k] = std::pow(0.5, k);
+    EXPECT_EQ(StandardChop(c, kRounding), p + 1) << "degree " << p;
+  }
+}
+
+// The same through a least-squares fit: noise-free samples of a cubic fitted at degree 40 give
+// coefficients 4..40 at rounding level (~1e-16 relative), which the chop removes.
+TEST(StandardChop, FindsTheDegreeOfAFittedPolynomial) {
+  const Eigen::Index m = 2000;
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(m, 0.0, 2.0);
+  Eigen::MatrixXd z(m, 1);
+  for (Eigen::Index i = 0; i < m; ++i) z(i, 0) = 1.0 + 2.0 * t[i] - 0.7 * t[i] * t[i] + 0.3 * t[i] * t[i] * t[i];
+  const ChebyshevSeries fit = FitLeastSquares(t, z, 40, Interval{0.0, 2.0});
+  EXPECT_EQ(StandardChop(fit.coefficients.col(0), kRounding), 4);
+}
+
+TEST(StandardChop, EdgeCases) {
+  // Fewer than 17 coefficients: the paper's test needs them, so all are kept (not resolved).
+  Eigen::VectorXd shortc = Eigen::VectorXd::Zero(16);
+  shortc[0] = 1.0;
+  EXPECT_EQ(StandardChop(shortc, kRounding), 16);
+  // A tolerance of 1 or more accepts any series as its constant term.
+  EXPECT_EQ(StandardChop(Eigen::VectorXd::Ones(30), 1.0), 1);
+  // An all-zero series is the constant 0.
+  EXPECT_EQ(StandardChop(Eigen::VectorXd::Zero(30), kRounding), 1);
+  // Signs do not matter: absolute values are used.
+  Eigen::VectorXd c = Eigen::VectorXd::Zero(40);
+  for (int k = 0; k <= 5; ++k) c[k] = (k % 2 ? -1.0 : 1.0) * std::pow(0.5, k);
+  EXPECT_EQ(StandardChop(c, kRounding), 6);
+}
+
+// A series |c_k| = 10^(-k/4) that sinks into a noise plateau at level ε (reached at k = -4·log10 ε),
+// chopped at tol = ε: the higher the noise, the fewer coefficients are kept, and the cut is at the
+// start of the plateau (the tilt of step 3 may cut a few coefficients before it, never after).
+TEST(StandardChop, CutsWhereTheSeriesSinksIntoTheNoise) {
+  for (const auto& [level, onset] : {std::pair{1e-4, 16}, std::pair{1e-8, 32}, std::pair{1e-12, 48}}) {
+    Eigen::VectorXd c(120);
+    for (int k = 0; k < 120; ++k) c[k] = std::max(std::pow(10.0, -k / 4.0), level * (1.0 + 0.3 * std::sin(k)));
+    const int keep = StandardChop(c, level);
+    EXPECT_GE(keep, onset - 4) << level;
+    EXPECT_LE(keep, onset + 1) << level;
+  }
+}
+
+// For z_i = a·(-1)^i every k-th difference is (-2)^k·a·(-1)^i: |Δ^k z| = 2^k·a at every i, so the
+// median is 2^k·a and the estimate is 1.4826·2^k·a / sqrt(C(2k, k)) exactly (up to rounding).
+TEST(EstimateNoiseSigma, ClosedFormOnAnAlternatingSequence) {
+  const Eigen::Index m = 101;
+  const double a = 0.25;
+  Eigen::MatrixXd z(m, 2);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    z(i, 0) = i % 2 ? -a : a;
+    z(i, 1) = 3.0 * z(i, 0);  // each column its own estimate
+  }
+  const Eigen::VectorXd s4 = EstimateNoiseSigma(z);  // order 4: C(8, 4) = 70
+  EXPECT_NEAR(s4[0], 1.4826 * 16.0 * a / std::sqrt(70.0), 1e-15);
+  EXPECT_NEAR(s4[1], 3.0 * 1.4826 * 16.0 * a / std::sqrt(70.0), 3e-15);
+  const Eigen::VectorXd s2 = EstimateNoiseSigma(z, 2);  // C(4, 2) = 6
+  EXPECT_NEAR(s2[0], 1.4826 * 4.0 * a / std::sqrt(6.0), 1e-15);
+  const Eigen::VectorXd s1 = EstimateNoiseSigma(z, 1);  // C(2, 1) = 2
+  EXPECT_NEAR(s1[0], 1.4826 * 2.0 * a / std::sqrt(2.0), 1e-15);
+}
+
+// The 4th difference of a cubic is zero: exact polynomial samples (integers here, so no rounding)
+// have no noise.
+TEST(EstimateNoiseSigma, ZeroOnPolynomialsOfDegreeBelowTheOrder) {
+  const Eigen::Index m = 50;
+  Eigen::MatrixXd z(m, 3);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const auto x = static_cast<double>(i);
+    z.row(i) << 7.0, 3.0 * x - 2.0, x * x * x - 4.0 * x * x + x;
+  }
+  EXPECT_EQ(EstimateNoiseSigma(z), Eigen::VectorXd::Zero(3));
+  // Too few samples for a single difference of order 4: zeros.
+  EXPECT_EQ(EstimateNoiseSigma(Eigen::MatrixXd::Ones(4, 2)), Eigen::VectorXd::Zero(2));
+}
+
+// White noise of σ on an oversampled smooth signal: the differences of the signal are negligible
+// and the MAD of the differences estimates sqrt(70)·σ. The median of m Gaussian magnitudes has a
+// relative standard error of about 1.1/sqrt(m) (differences 4 apart are independent, neighbours are
+// correlated, which roughly doubles it): ~1 % at m = 20,000, so 4 % is a safe bound.
+TEST(EstimateNoiseSigma, RecoversTheNoiseOfASmoothSignal) {
+  std::mt19937_64 rng(11);
+  const Eigen::Index m = 20000;
+  for (double sigma : {1e-4, 1e-3, 2e-2}) {
+    std::normal_distribution<double> noise(0.0, sigma);
+    Eigen::MatrixXd z(m, 2);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      const double t = static_cast<double>(i) * 0.005;  // 200 Hz
+      z.row(i) << std::sin(0.7 * t) + noise(rng), 2.0 * std::cos(0.3 * t) + 0.1 * t + noise(rng);
+    }
+    const Eigen::VectorXd estimate = EstimateNoiseSigma(z);
+    EXPECT_NEAR(estimate[0], sigma, 0.04 * sigma);
+    EXPECT_NEAR(estimate[1], sigma, 0.04 * sigma);
+  }
+}
+
+// Robust: 1 % of the samples replaced by 1 m outliers (each spoils 5 of the differences, so ~5 %
+// of them) moves the median only slightly, where a standard deviation would be ~1000x too large.
+TEST(EstimateNoiseSigma, OutliersBarelyMoveTheEstimate) {
+  std::mt19937_64 rng(12);
+  std::normal_distribution<double> noise(0.0, 1e-3);
+  const Eigen::Index m = 20000;
+  Eigen::MatrixXd z(m, 1);
+  for (Eigen::Index i = 0; i < m; ++i) z(i, 0) = std::sin(static_cast<double>(i) * 0.005) + noise(rng);
+  for (Eigen::Index i = 50; i < m; i += 100) z(i, 0) += 1.0;
+  const double estimate = EstimateNoiseSigma(z)[0];
+  EXPECT_GT(estimate, 1e-3);  // the outliers can only widen the distribution
+  EXPECT_LT(estimate, 1.15e-3);
+}
+
+}  // namespace
+}  // namespace cheval::cheb
