@@ -18,6 +18,7 @@
 #include <ceres/ceres.h>
 
 #include "cheval/common/error.h"
+#include "cheval/common/random.h"
 #include "cheval/common/options.h"
 #include "cheval/estim/problem.h"
 
@@ -299,7 +300,9 @@ ThrustEstimate EstimateThrust(const ThrustFlight& flight, const ThrustEstimateOp
   }
 
   // The positions used: the first sample at or after each tick of the position rate, plus noise.
-  std::mt19937_64 engine(options.seed);
+  // The project's generator with the engine seeded as before; the normals come from the standard
+  // library's distribution (as they always did here), so they may differ between standard libraries.
+  Random random = Random::FromEngineSeed(options.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   std::vector<double> tp;
   std::vector<Eigen::Vector3d> pp;
@@ -309,7 +312,7 @@ ThrustEstimate EstimateThrust(const ThrustFlight& flight, const ThrustEstimateOp
     if (t[i] + 1e-9 < next) continue;
     Eigen::Vector3d noisy = p[i];
     if (options.position_noise_m > 0) {
-      for (int axis = 0; axis < 3; ++axis) noisy[axis] += options.position_noise_m * normal(engine);
+      for (int axis = 0; axis < 3; ++axis) noisy[axis] += options.position_noise_m * normal(random);
     }
     tp.push_back(t[i]);
     pp.push_back(noisy);
