@@ -140,8 +140,8 @@ void QuadrotorEstimateOptions::Validate() const {
   check(positive(sigma_rotation_rate), "sigma_rotation_rate", "must be > 0, got {}", sigma_rotation_rate);
   check(positive(sigma_rotor_rate), "sigma_rotor_rate", "must be > 0, got {}", sigma_rotor_rate);
   check(pilot_iterations >= 1, "pilot_iterations", "must be >= 1, got {}", pilot_iterations);
-  check(positive(adaptive_rotor_prior_floor), "adaptive_rotor_prior_floor", "must be > 0, got {}",
-        adaptive_rotor_prior_floor);
+  check(positive(rotor_prior_sigma_floor), "rotor_prior_sigma_floor", "must be > 0, got {}",
+        rotor_prior_sigma_floor);
   check(positive(thrust_prior_max_rate), "thrust_prior_max_rate", "must be > 0, got {}", thrust_prior_max_rate);
   check(positive(huber_pixels), "huber_pixels", "must be > 0, got {}", huber_pixels);
   check(positive(initial_window_s), "initial_window_s", "must be > 0, got {}", initial_window_s);
@@ -276,7 +276,7 @@ void SetPriorsFromPilot(Problem& problem, const QuadrotorParameters& vehicle, co
   std::vector<double> energy(S);
   for (int s = 0; s < S; ++s) energy[s] = problem.ControlDerivativeEnergy(1, s);
   std::vector<double> sigma = AdaptiveRotorPriorSigma(energy, options.degree, QuadrotorModel::kControlDim);
-  for (double& x : sigma) x = std::max(options.adaptive_rotor_prior_floor, x);
+  for (double& x : sigma) x = std::max(options.rotor_prior_sigma_floor, x);
   Problem::ControlBasis basis = RotorBasis();
   if (options.thrust_prior) {
     problem.RemoveControlSmoothnessPrior(1);

@@ -315,8 +315,8 @@ TEST(QuadrotorEstimator, BadOptionsNameTheField) {
   bad.pilot_iterations = 0;
   EXPECT_EQ(message(bad), "QuadrotorEstimateOptions::pilot_iterations must be >= 1, got 0");
   bad = {};
-  bad.adaptive_rotor_prior_floor = 0;
-  EXPECT_EQ(message(bad), "QuadrotorEstimateOptions::adaptive_rotor_prior_floor must be > 0, got 0");
+  bad.rotor_prior_sigma_floor = 0;
+  EXPECT_EQ(message(bad), "QuadrotorEstimateOptions::rotor_prior_sigma_floor must be > 0, got 0");
   bad = {};
   bad.sigma_rotor_rate = 0;
   EXPECT_EQ(message(bad), "QuadrotorEstimateOptions::sigma_rotor_rate must be > 0, got 0");

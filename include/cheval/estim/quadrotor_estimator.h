@@ -50,7 +50,7 @@ struct QuadrotorEstimateOptions {
   int pilot_iterations = 1;
   /// Lower bound of the per-segment σ of the rotor prior after the pilot, σ_s = max(floor,
   /// AdaptiveRotorPriorSigma), rad/s² per s^(1/2) (> 0).
-  double adaptive_rotor_prior_floor = 30;
+  double rotor_prior_sigma_floor = 30;
   /// After the pilot, the collective rotor speed's prior is the Matérn-3/2 prior on the world-frame
   /// thrust acceleration (docs/estimator.md, "The algorithm", step 5); the differential (roll,
   /// pitch, yaw) components keep the rotor prior. false: the collective keeps the rotor prior too.
