@@ -1,5 +1,6 @@
 // cheval: one executable, one subcommand per file. main() parses, runs the chosen action and maps
-// the library's typed errors to the documented exit codes (docs/cli.md).
+// the library's typed errors to the documented exit codes (docs/cli.md), each message with the
+// library's option fields spelled as flags (option_names.h).
 #include <cstdio>
 #include <exception>
 
@@ -7,6 +8,7 @@
 
 #include "cheval/common/error.h"
 #include "common.h"
+#include "option_names.h"
 #include "progress.h"
 
 int main(int argc, char** argv) {
@@ -35,7 +37,7 @@ int main(int argc, char** argv) {
   cheval::cli::RegisterEstimateThrust(app, &action);
 
   auto fail = [](ExitCode code, const std::string& message) {
-    std::fprintf(stderr, "%s\n", message.c_str());
+    std::fprintf(stderr, "%s\n", cheval::cli::Spell(message).c_str());
     return static_cast<int>(code);
   };
   try {
