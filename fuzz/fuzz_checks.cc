@@ -229,14 +229,14 @@ Violation CheckColumnMap(const ColumnMap& map) {
 Violation CheckTrajectoryTarget(std::string_view target, std::string_view content) {
   traj::ReadOptions options;
   if (target == "column_map") {
-    // The first line is a --columns spec, the rest a csv file read with it.
+    // The first line is a column map spec, the rest a csv file read with it.
     const size_t newline = content.find('\n');
     const std::string_view spec = content.substr(0, newline);
     content = newline == std::string_view::npos ? std::string_view() : content.substr(newline + 1);
     try {
       options.columns = ColumnMap::Parse(spec);
     } catch (const UsageError& e) {
-      FUZZ_REQUIRE(StartsWith(e.what(), "--columns:"), std::string("message: ") + e.what());
+      FUZZ_REQUIRE(StartsWith(e.what(), "ReadOptions::columns:"), std::string("message: ") + e.what());
       return std::nullopt;
     } catch (const Error& e) {
       return std::string("ColumnMap::Parse threw a cheval::Error that is not a UsageError: ") + e.what();

@@ -11,7 +11,8 @@ Trajectories and files go in wherever one is expected: a path (str or os.PathLik
 ``cheval.Trajectory``, or a mapping with the Trajectory constructor's keys (``stamps``,
 ``positions``, optional ``quaternions``, ``velocities``, ``angular_velocities``). Arrays come out
 as numpy arrays over the library's memory (no copy) where the layout allows; see docs/python.md for
-where a copy is made. Errors are the library's typed errors with the CLI's messages:
+where a copy is made. Errors are the library's typed errors with its messages, options spelled as
+the keyword arguments of these functions:
 ``InputError`` and ``UsageError`` (both ``ValueError``), ``ComputeError`` (``RuntimeError``),
 ``OutputError`` (``OSError``), all subclasses of ``cheval.Error``.
 """
@@ -50,8 +51,9 @@ DEFAULT_VEHICLE = _os.path.join(_os.path.dirname(__file__), "vehicles", "flightg
 for _cls in (Trajectory, Curve, Model, Compression):
     _cls.__module__ = "cheval"  # shown as cheval.Trajectory, where users find them
 
-# evo's one-letter units of --delta-unit, as the CLI accepts them.
-_DELTA_UNIT_LETTERS = {"f": "frames", "m": "meters", "d": "degrees", "r": "radians"}
+# The library's defaults these signatures show (each lives in its options struct).
+_DEFAULTS = _cheval.defaults()
+_T_MAX_DIFF, _T_OFFSET = _DEFAULTS["t_max_diff"], _DEFAULTS["t_offset"]
 
 
 def _columns_text(columns):
@@ -180,7 +182,7 @@ def _check_input_options(function, options):
         raise TypeError(f"{function}() got unexpected keyword argument(s): {', '.join(sorted(unknown))}")
 
 
-def associate(ref, est, *, t_max_diff=0.01, t_offset=0.0, **inputs):
+def associate(ref, est, *, t_max_diff=_T_MAX_DIFF, t_offset=_T_OFFSET, **inputs):
     """evo's time association (docs/evaluation.md): for each pose of the shorter trajectory the
     nearest stamp of the other within t_max_diff seconds (inclusive), est + t_offset = ref.
     Returns {'ref': (k,) int64 indices, 'est': (k,) int64 indices, 'by_index': bool} (KITTI files
@@ -191,7 +193,7 @@ def associate(ref, est, *, t_max_diff=0.01, t_offset=0.0, **inputs):
     return _cheval.associate(r, e, t_max_diff=t_max_diff, t_offset=t_offset)
 
 
-def align(ref, est, *, method="se3", n_align=0, t_max_diff=0.01, t_offset=0.0, **inputs):
+def align(ref, est, *, method="se3", n_align=0, t_max_diff=_T_MAX_DIFF, t_offset=_T_OFFSET, **inputs):
     """The alignment of the estimate onto the reference from the associated pairs, as ``--align``:
     method 'none', 'origin', 'se3', 'sim3', 'scale', 'posyaw' or 'full'; n_align: solve from the
     first N pairs (0: all). Returns {'method', 'rotation' (3, 3), 'translation' (3,), 'scale',
@@ -205,8 +207,6 @@ def align(ref, est, *, method="se3", n_align=0, t_max_diff=0.01, t_offset=0.0, *
 def _evaluate(metric, ref, est, errors, inputs, options):
     _check_input_options(metric, inputs)
     r, e = _sides(ref, est, inputs)
-    if "delta_unit" in options:
-        options["delta_unit"] = _DELTA_UNIT_LETTERS.get(options["delta_unit"], options["delta_unit"])
     text, per_pair = _cheval.evaluate(r, e, metric, **options)
     result = _json.loads(text)
     if errors:
@@ -225,18 +225,19 @@ _COMMON_DOC = """
     Returns the dict the CLI's --json writes (same keys, same numbers; 'path' is the path given,
     or '<array>'). errors=True adds 'errors': per-pair numpy arrays 'stamps' (int64 ns), 'error'
     (+ 'stamps_end' for RPE, the parts for ASE), as the CLI's --errors CSV.
-    Raises InputError, UsageError or ComputeError with the CLI's messages.
+    Raises InputError, UsageError or ComputeError with the library's messages, options spelled as
+    these keywords (e.g. "n_align needs align (se3, sim3, scale, posyaw or full)").
 """
 
 
-def ape(ref, est, *, align="none", n_align=0, t_max_diff=0.01, t_offset=0.0, association="nearest",
+def ape(ref, est, *, align="none", n_align=0, t_max_diff=_T_MAX_DIFF, t_offset=_T_OFFSET, association="nearest",
         relation="trans_part", errors=False, **inputs):
     return _evaluate("ape", ref, est, errors, inputs, dict(
         align=align, n_align=n_align, t_max_diff=t_max_diff, t_offset=t_offset, association=association,
         relation=relation))
 
 
-def rpe(ref, est, *, align="none", n_align=0, t_max_diff=0.01, t_offset=0.0, association="nearest",
+def rpe(ref, est, *, align="none", n_align=0, t_max_diff=_T_MAX_DIFF, t_offset=_T_OFFSET, association="nearest",
         relation="trans_part", delta=1.0, delta_unit="frames", all_pairs=False, kitti_drift=False,
         errors=False, **inputs):
     return _evaluate("rpe", ref, est, errors, inputs, dict(
@@ -244,7 +245,7 @@ def rpe(ref, est, *, align="none", n_align=0, t_max_diff=0.01, t_offset=0.0, ass
         relation=relation, delta=delta, delta_unit=delta_unit, all_pairs=all_pairs, kitti_drift=kitti_drift))
 
 
-def ase(ref, est, *, align="none", n_align=0, t_max_diff=0.01, t_offset=0.0, association="nearest",
+def ase(ref, est, *, align="none", n_align=0, t_max_diff=_T_MAX_DIFF, t_offset=_T_OFFSET, association="nearest",
         gt_velocity="auto", velocity_frame="world", pose_only=False, errors=False, **inputs):
     return _evaluate("ase", ref, est, errors, inputs, dict(
         align=align, n_align=n_align, t_max_diff=t_max_diff, t_offset=t_offset, association=association,

@@ -7,6 +7,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -72,15 +73,18 @@ inline std::span<const int64_t> SpanOf(const py::array_t<int64_t>& stamps) {
   return {stamps.data(), static_cast<size_t>(stamps.size())};
 }
 
-/// The library's read options from the Python arguments (format name, column map spec, KITTI
-/// times path), validated as the CLI validates --format / --columns / --kitti-times.
-traj::ReadOptions ReadOptionsOf(const std::string& format, const std::string& columns, const std::string& kitti_times);
-
 /// Curve options from the Python arguments of fit and velocity: degree 'auto' (= 'cv'), 'chop' or
-/// an int (a fixed degree; one global fit when no window is given, as `cheval velocity --degree
-/// N`), window (s) and noise sigma (None: adaptive / estimated). The library validates the values
-/// (OptionError, raised as UsageError).
+/// an int (eval::CurveOptionsFromNames), window (s) and noise sigma (None: adaptive /
+/// estimated). The library validates the values (OptionError).
 cheb::CurveOptions CurveOptionsOf(const py::object& degree, std::optional<double> window, std::optional<double> noise);
+
+/// The keyword argument of a library options field ("AlignmentOptions::n_align" -> "n_align"), from
+/// the one table of python/src/option_names.cc; std::logic_error for a field not in it.
+const char* Keyword(std::string_view field);
+
+/// `message` with every options field of that table spelled as its keyword (the exception
+/// translator applies it to every library error).
+std::string Spell(std::string_view message);
 
 void BindErrors(py::module_& m);
 void BindTrajectory(py::module_& m);

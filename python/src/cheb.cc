@@ -7,6 +7,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.h"
+#include "cheval/eval/velocity.h"
 #include "cheval/cheb/compress.h"
 #include "cheval/cheb/model.h"
 #include "cheval/common/error.h"
@@ -70,24 +71,15 @@ cheb::Compression CompressSamples(std::span<const int64_t> stamps, const Eigen::
 }  // namespace
 
 cheb::CurveOptions CurveOptionsOf(const py::object& degree, std::optional<double> window, std::optional<double> noise) {
-  cheb::CurveOptions options;
+  std::string name;
   if (py::isinstance<py::str>(degree)) {
-    const auto name = degree.cast<std::string>();
-    if (name == "auto" || name == "cv") {
-      options.degree_method = cheb::DegreeMethod::kCrossValidation;
-    } else if (name == "chop") {
-      options.degree_method = cheb::DegreeMethod::kChop;
-    } else {
-      throw UsageError(fmt::format("degree: expected 'auto', 'cv', 'chop' or an int, got '{}'", name));
-    }
+    name = degree.cast<std::string>();
   } else if (py::isinstance<py::int_>(degree) && !py::isinstance<py::bool_>(degree)) {
-    options.degree_method = cheb::DegreeMethod::kFixed;
-    options.fixed_degree = degree.cast<int>();
-    options.single_window = !window.has_value();  // a fixed degree alone: one global fit (as `cheval velocity`)
+    name = std::to_string(degree.cast<long long>());
   } else {
     throw UsageError("degree: expected 'auto', 'cv', 'chop' or an int");
   }
-  options.window_s = window;
+  cheb::CurveOptions options = eval::CurveOptionsFromNames(name, window);
   options.noise_sigma = noise;
   return options;
 }

@@ -27,18 +27,10 @@ bool OneOf(const std::string& value, const char* option, const char* first, cons
   return value == second;
 }
 
-eval::AssociationOptions AssociationOptionsOf(double t_max_diff, double t_offset) {
-  eval::AssociationOptions options;
-  options.max_diff_ns = eval::SecondsToNanoseconds(t_max_diff, "--t-max-diff");
-  options.offset_ns = eval::SecondsToNanoseconds(t_offset, "--t-offset");
-  return options;
-}
-
 py::dict Velocity(const py::object& self, const py::object& at, const std::string& method, const py::object& degree,
                   std::optional<double> window, int savgol_window, bool angular) {
   const PyTrajectory& t = self.cast<const PyTrajectory&>();
   const traj::TrajectoryView view = t.trajectory.View();
-  if (!view.has_stamps()) throw ComputeError("velocity needs stamps; give the KITTI times with kitti_times=");
   eval::VelocityOptions options;
   options.method = Choice(eval::VelocityMethodFromString(method), "method", method, "chebyshev, central, savgol");
   if (window && options.method == eval::VelocityMethod::kSavitzkyGolay) {
@@ -81,7 +73,7 @@ py::dict Velocity(const py::object& self, const py::object& at, const std::strin
 }
 
 py::dict Associate(const PyTrajectory& ref, const PyTrajectory& est, double t_max_diff, double t_offset) {
-  const eval::AssociationOptions options = AssociationOptionsOf(t_max_diff, t_offset);
+  const eval::AssociationOptions options = eval::AssociationOptions::FromSeconds(t_max_diff, t_offset);
   eval::Association association;
   {
     py::gil_scoped_release release;
@@ -97,11 +89,11 @@ py::dict Associate(const PyTrajectory& ref, const PyTrajectory& est, double t_ma
 py::dict Align(const PyTrajectory& ref, const PyTrajectory& est, const std::string& method, Eigen::Index n_align,
                double t_max_diff, double t_offset) {
   eval::EvaluationOptions options;
-  options.association = AssociationOptionsOf(t_max_diff, t_offset);
+  options.association = eval::AssociationOptions::FromSeconds(t_max_diff, t_offset);
   options.alignment.method = Choice(eval::AlignmentMethodFromString(method), "method", method,
                                     "none, origin, se3, sim3, scale, posyaw, full");
   options.alignment.n_align = n_align;
-  eval::ValidateEvaluationOptions(options);
+  options.Validate();
   eval::AlignmentResult result;
   {
     py::gil_scoped_release release;
@@ -127,7 +119,7 @@ py::tuple Evaluate(const PyTrajectory& ref, const PyTrajectory& est, const std::
   eval::EvaluationReport report;
   eval::EvaluationOptions& options = report.options;
   options.metric = metric == "ape" ? eval::MetricKind::kApe : metric == "rpe" ? eval::MetricKind::kRpe : eval::MetricKind::kAse;
-  options.association = AssociationOptionsOf(t_max_diff, t_offset);
+  options.association = eval::AssociationOptions::FromSeconds(t_max_diff, t_offset);
   options.continuous_reference = OneOf(association, "association", "nearest", "continuous");
   options.alignment.method = Choice(eval::AlignmentMethodFromString(align), "align", align,
                                     "none, origin, se3, sim3, scale, posyaw, full");
@@ -136,20 +128,18 @@ py::tuple Evaluate(const PyTrajectory& ref, const PyTrajectory& est, const std::
                             "trans_part, rot_part, full, angle_deg, angle_rad, point_distance");
   options.rpe.delta = delta;
   options.rpe.delta_unit =
-      Choice(eval::DeltaUnitFromString(delta_unit), "delta_unit", delta_unit, "frames, meters, degrees, radians");
+      Choice(eval::DeltaUnitFromString(delta_unit), "delta_unit", delta_unit, "frames, meters, degrees, radians (or f, m, d, r)");
   options.rpe.all_pairs = all_pairs;
   options.kitti_drift = kitti_drift;
   options.reference_velocity = Choice(eval::ReferenceVelocitySourceFromString(gt_velocity), "gt_velocity",
                                       gt_velocity, "auto, given, chebyshev, central");
   options.estimate_velocity_body_frame = OneOf(velocity_frame, "velocity_frame", "world", "body");
   options.pose_only = pose_only;
-  eval::ValidateEvaluationOptions(options);
+  options.Validate();
   report.reference_path = ref.path;
   report.reference_poses = ref.trajectory.size();
   report.estimate_path = est.path;
   report.estimate_poses = est.trajectory.size();
-  report.max_diff_s = t_max_diff;
-  report.offset_s = t_offset;
   std::string json;
   {
     py::gil_scoped_release release;
@@ -172,21 +162,44 @@ py::tuple Evaluate(const PyTrajectory& ref, const PyTrajectory& est, const std::
 }  // namespace
 
 void BindEvaluation(py::module_& m) {
+  // Every default is the library's (the options structs); every keyword comes from option_names.cc.
+  const eval::EvaluationOptions defaults;
+  const eval::VelocityOptions velocity;
+  const auto k = [](const char* field) { return py::arg(Keyword(field)); };
   m.def("velocity", &Velocity, py::arg("trajectory"), py::kw_only(), py::arg("at") = py::none(),
-        py::arg("method") = "chebyshev", py::arg("degree") = "auto", py::arg("window") = py::none(),
-        py::arg("savgol_window") = 21, py::arg("angular") = false,
+        k("VelocityOptions::method") = std::string(eval::ToString(velocity.method)),
+        k("CurveOptions::degree_method") = eval::DegreeName(velocity.curve), k("CurveOptions::window_s") = py::none(),
+        k("VelocityOptions::savgol_window") = velocity.savgol_window, k("VelocityOptions::angular") = velocity.angular,
         "The compiled velocity; use cheval.velocity (docs/python.md).");
-  m.def("associate", &Associate, py::arg("ref"), py::arg("est"), py::kw_only(), py::arg("t_max_diff") = 0.01,
-        py::arg("t_offset") = 0.0, "The compiled association; use cheval.associate.");
+  m.def("associate", &Associate, py::arg("ref"), py::arg("est"), py::kw_only(),
+        k("AssociationOptions::max_diff_ns") = defaults.association.max_diff_s(),
+        k("AssociationOptions::offset_ns") = defaults.association.offset_s(),
+        "The compiled association; use cheval.associate.");
   m.def("align", &Align, py::arg("ref"), py::arg("est"), py::kw_only(), py::arg("method") = "se3",
-        py::arg("n_align") = 0, py::arg("t_max_diff") = 0.01, py::arg("t_offset") = 0.0,
+        k("AlignmentOptions::n_align") = defaults.alignment.n_align,
+        k("AssociationOptions::max_diff_ns") = defaults.association.max_diff_s(),
+        k("AssociationOptions::offset_ns") = defaults.association.offset_s(),
         "The compiled alignment; use cheval.align.");
   m.def("evaluate", &Evaluate, py::arg("ref"), py::arg("est"), py::arg("metric"), py::kw_only(),
-        py::arg("align") = "none", py::arg("n_align") = 0, py::arg("t_max_diff") = 0.01, py::arg("t_offset") = 0.0,
-        py::arg("association") = "nearest", py::arg("relation") = "trans_part", py::arg("delta") = 1.0,
-        py::arg("delta_unit") = "frames", py::arg("all_pairs") = false, py::arg("kitti_drift") = false,
-        py::arg("gt_velocity") = "auto", py::arg("velocity_frame") = "world", py::arg("pose_only") = false,
+        k("AlignmentOptions::method") = std::string(eval::ToString(defaults.alignment.method)),
+        k("AlignmentOptions::n_align") = defaults.alignment.n_align,
+        k("AssociationOptions::max_diff_ns") = defaults.association.max_diff_s(),
+        k("AssociationOptions::offset_ns") = defaults.association.offset_s(),
+        py::arg("association") = defaults.continuous_reference ? "continuous" : "nearest",
+        k("EvaluationOptions::relation") = std::string(eval::ToString(defaults.relation)),
+        k("RpeOptions::delta") = defaults.rpe.delta,
+        k("RpeOptions::delta_unit") = std::string(eval::ToString(defaults.rpe.delta_unit)),
+        k("RpeOptions::all_pairs") = defaults.rpe.all_pairs, k("EvaluationOptions::kitti_drift") = defaults.kitti_drift,
+        k("EvaluationOptions::reference_velocity") = std::string(eval::ToString(defaults.reference_velocity)),
+        k("EvaluationOptions::estimate_velocity_body_frame") = defaults.estimate_velocity_body_frame ? "body" : "world",
+        k("EvaluationOptions::pose_only") = defaults.pose_only,
         "The compiled evaluation; use cheval.ape, cheval.rpe, cheval.ase.");
+  m.def("defaults", [defaults] {
+    py::dict out;
+    out["t_max_diff"] = defaults.association.max_diff_s();
+    out["t_offset"] = defaults.association.offset_s();
+    return out;
+  }, "The library's defaults the Python signatures repeat (cheval/__init__.py).");
 }
 
 }  // namespace cheval::python

@@ -2,7 +2,6 @@
 // hand-over helpers, and the registration of every binding. python/cheval/__init__.py is the public
 // face over it (docs/python.md).
 #include <exception>
-#include <map>
 #include <string>
 
 #include "bindings.h"
@@ -26,8 +25,9 @@ PyObject* NewException(py::module_& m, const char* name, const char* doc, py::tu
   return type;
 }
 
-// Raises `type` with the library's message (what()) as its only argument, the message a CLI user sees.
-void Raise(PyObject* type, const std::exception& e) { PyErr_SetString(type, e.what()); }
+// Raises `type` with the library's message (what()) as its only argument, the options it names
+// spelled as keyword arguments (option_names.cc).
+void Raise(PyObject* type, const std::exception& e) { PyErr_SetString(type, Spell(e.what()).c_str()); }
 
 }  // namespace
 
@@ -49,7 +49,9 @@ void BindErrors(py::module_& m) {
        "Attributes: path, line, column (1-based; 0 = the file as a whole) and detail (WHAT alone).",
        value_error},
       {&g_usage_error, "UsageError",
-       "A bad option value or combination, found before any work (the CLI's exit code 1).", value_error},
+       "A bad option value or combination, found before any work (the CLI's exit code 1); the message names the "
+       "keyword argument.",
+       value_error},
       {&g_compute_error, "ComputeError",
        "Well-formed input on which the computation is impossible, e.g. no associated pair or too few samples "
        "(the CLI's exit code 3). The message says what to change.",
@@ -63,17 +65,12 @@ void BindErrors(py::module_& m) {
     try {
       if (thrown) std::rethrow_exception(thrown);
     } catch (const InputError& e) {
-      py::object exc = py::handle(g_input_error)(e.what());
+      py::object exc = py::handle(g_input_error)(Spell(e.what()));
       exc.attr("path") = e.path();
       exc.attr("line") = e.line();
       exc.attr("column") = e.column();
-      exc.attr("detail") = e.detail();
+      exc.attr("detail") = Spell(e.detail());
       PyErr_SetObject(g_input_error, exc.ptr());
-    } catch (const OptionError& e) {
-      // The library names the options field; these messages have always named the CLI flag.
-      static const std::map<std::string, std::string> kNames{{"window_s", "--window"}, {"tolerance", "--tolerance"}};
-      const auto name = kNames.find(e.field());
-      PyErr_SetString(g_usage_error, (name == kNames.end() ? std::string(e.what()) : e.Message(name->second)).c_str());
     } catch (const UsageError& e) {
       Raise(g_usage_error, e);
     } catch (const ComputeError& e) {

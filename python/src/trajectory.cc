@@ -95,22 +95,6 @@ traj::Format FormatOf(const std::string& name) {
 
 }  // namespace
 
-traj::ReadOptions ReadOptionsOf(const std::string& format, const std::string& columns, const std::string& kitti_times) {
-  traj::ReadOptions options;
-  options.format = FormatOf(format);
-  if (!columns.empty()) {
-    if (options.format != traj::Format::kCsv && options.format != traj::Format::kAuto) {
-      throw UsageError(fmt::format("columns= is only for format='csv' (got format='{}')", format));
-    }
-    options.format = traj::Format::kCsv;
-    options.columns = traj::ColumnMap::Parse(columns);
-  } else if (options.format == traj::Format::kCsv) {
-    throw UsageError("format='csv' needs columns= (e.g. columns='t,px,py,pz,qx,qy,qz,qw')");
-  }
-  options.kitti_times_path = kitti_times;
-  return options;
-}
-
 void BindTrajectory(py::module_& m) {
   py::class_<PyTrajectory>(m, "Trajectory", R"(A stamped trajectory: stamps (int64 ns), positions, optional orientations,
 world-frame velocities and body-frame angular velocities.
@@ -195,7 +179,7 @@ are immutable; the array properties are read-only views of the stored data (no c
       "read",
       [](const std::string& path, const std::string& format, const std::string& columns,
          const std::string& kitti_times) {
-        const traj::ReadOptions options = ReadOptionsOf(format, columns, kitti_times);
+        const traj::ReadOptions options = traj::ReadOptions::FromNames(format, columns, kitti_times);
         PyTrajectory out;
         {
           py::gil_scoped_release release;
@@ -248,14 +232,19 @@ velocity for tumv) and OutputError when the file cannot be written.)");
         PyTrajectory truth{sim::GenerateMotion(model), "<simulated truth>"};
         return std::make_pair(std::move(measured), std::move(truth));
       },
-      py::arg("kind") = "drone", py::arg("seed") = 1, py::arg("duration") = py::none(), py::arg("rate") = py::none(),
-      py::arg("noise") = 0.0, py::arg("rotation_noise") = 0.0, py::arg("jitter") = 0.0, py::arg("dropout") = 0.0,
-      py::arg("gap_count") = 0, py::arg("gap_seconds") = 0.0,
+      py::arg(Keyword("MotionOptions::kind")) = std::string(sim::ToString(sim::MotionOptions{}.kind)), py::arg(Keyword("MotionOptions::seed")) = sim::MotionOptions{}.seed,
+      py::arg(Keyword("MotionOptions::duration_s")) = py::none(), py::arg(Keyword("MotionOptions::rate_hz")) = py::none(),
+      py::arg(Keyword("MeasurementOptions::noise_m")) = sim::MeasurementOptions{}.noise_m,
+      py::arg(Keyword("MeasurementOptions::rotation_noise_rad")) = sim::MeasurementOptions{}.rotation_noise_rad,
+      py::arg(Keyword("MeasurementOptions::jitter_s")) = sim::MeasurementOptions{}.jitter_s,
+      py::arg(Keyword("MeasurementOptions::dropout_probability")) = sim::MeasurementOptions{}.dropout_probability,
+      py::arg(Keyword("MeasurementOptions::gap_count")) = sim::MeasurementOptions{}.gap_count,
+      py::arg(Keyword("MeasurementOptions::gap_s")) = sim::MeasurementOptions{}.gap_s,
       R"(Synthetic motion with exact derivatives, as `cheval sim motion` (docs/sim.md): returns
 (measured, truth). truth: the exact poses, world-frame velocities and body rates on the nominal
 grid; measured: poses at jittered stamps with dropouts and gaps, positions + N(0, noise²) per
 axis, orientations perturbed by rotation_noise (rad). kind: car, legged, drone or handheld;
-duration (s) and rate (Hz) default per kind. Raises UsageError naming the CLI option for bad values.)");
+duration (s) and rate (Hz) default per kind. Raises UsageError naming the keyword for bad values.)");
 }
 
 }  // namespace cheval::python

@@ -24,6 +24,22 @@ def cli_json(*args):
             return json.load(f), list(csv.DictReader(g))
 
 
+# The CLI's flags and Python's keywords for the same options (tools/cheval/option_names.cc,
+# python/src/option_names.cc), longest first so that --delta-unit is not read as --delta.
+_KEYWORDS = sorted({"--t-max-diff": "t_max_diff", "--t-offset": "t_offset", "--n-align": "n_align",
+                    "--align": "align", "--pose-only": "pose_only", "--velocity-frame": "velocity_frame",
+                    "--delta-unit": "delta_unit", "--delta": "delta", "--all-pairs": "all_pairs",
+                    "--gt-velocity": "gt_velocity", "--columns": "columns", "--format": "format",
+                    "--kitti-times": "kitti_times"}.items(), key=lambda item: -len(item[0]))
+
+
+def as_keywords(message):
+    """A CLI message with each flag spelled as Python's keyword."""
+    for flag, keyword in _KEYWORDS:
+        message = message.replace(flag, keyword)
+    return message
+
+
 def cli_error(*args):
     """The exit code and the message (stderr without the CLI's prefix) of a failing command."""
     code, _, err = run_cli(*args)
@@ -140,6 +156,25 @@ class SimulatedEvaluationTest(unittest.TestCase):
                 self.assertEqual(expected_code, code)
                 with self.assertRaises(error) as raised:
                     call()
+                # The same message, each face spelling the options its way.
+                self.assertEqual(str(raised.exception), as_keywords(message))
+
+    def test_option_errors_name_the_keyword(self):
+        ref, est = self.ref_path, self.est_path
+        cases = [
+            (lambda: cheval.ape(ref, est, n_align=5), "n_align needs align (se3, sim3, scale, posyaw or full)"),
+            (lambda: cheval.ape(ref, est, t_max_diff=-1), "t_max_diff must be >= 0, got -1.000000000 s"),
+            (lambda: cheval.rpe(ref, est, delta=1.5), "delta must be an integer for delta_unit frames, got 1.5"),
+            (lambda: cheval.ase(ref, est, pose_only=True, velocity_frame="body"),
+             "pose_only ignores velocity: drop velocity_frame"),
+            (lambda: cheval.velocity(ref, degree="foo"),
+             "degree must be auto, cv, chop or a non-negative integer, got 'foo'"),
+        ]
+        for call, message in cases:
+            with self.subTest(message=message):
+                with self.assertRaises(ValueError) as raised:
+                    call()
+                self.assertIsInstance(raised.exception, cheval.UsageError)
                 self.assertEqual(str(raised.exception), message)
 
     def test_python_only_argument_errors(self):

@@ -38,7 +38,7 @@ class SimulatorTest(unittest.TestCase):
     def test_bad_option_names_the_cli_option(self):
         with self.assertRaises(cheval.UsageError) as raised:
             cheval.simulate(rate=-1)
-        self.assertEqual(str(raised.exception), "--rate must be a positive number of Hz, got -1")
+        self.assertEqual(str(raised.exception), "rate must be a positive number of Hz, got -1")
         with self.assertRaises(cheval.UsageError):
             cheval.simulate(kind="boat")
 
@@ -105,7 +105,7 @@ class VelocityTest(unittest.TestCase):
             cheval.velocity(self.measured, at=at, method="central")  # only at the trajectory's own stamps
         with self.assertRaises(cheval.UsageError) as raised:
             cheval.velocity(self.measured, window=-1.0)
-        self.assertEqual(str(raised.exception), "--window must be a positive number of seconds, got -1")
+        self.assertEqual(str(raised.exception), "window must be a positive number of seconds, got -1")
 
 
 class FitTest(unittest.TestCase):
@@ -167,7 +167,7 @@ class CompressTest(unittest.TestCase):
         measured, _ = cheval.simulate(kind="legged", seed=1, noise=0.001, duration=5)
         with self.assertRaises(cheval.UsageError) as raised:
             cheval.compress(measured, tolerance=-1.0)
-        self.assertEqual(str(raised.exception), "--tolerance must be a positive number of metres, got -1")
+        self.assertEqual(str(raised.exception), "tolerance must be a positive number of metres, got -1")
         with self.assertRaises(cheval.ComputeError):
             cheval.compress(measured, tolerance=1e-9)  # far below the noise
         with self.assertRaises(cheval.InputError) as raised:

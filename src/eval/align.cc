@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "cheval/common/error.h"
+#include "cheval/common/options.h"
 #include "enum_names.h"
 
 namespace cheval::eval {
@@ -18,8 +19,9 @@ constexpr Eigen::Index kMinPairs = 3;
 
 void RequirePairs(Eigen::Index n, std::string_view method) {
   if (n < kMinPairs) {
-    throw ComputeError(fmt::format("{} alignment needs at least {} associated pairs, got {} (check --t-max-diff, "
-                                   "--t-offset or --n-align)",
+    throw ComputeError(fmt::format("{} alignment needs at least {} associated pairs, got {} (check "
+                                   "AssociationOptions::max_diff_ns, AssociationOptions::offset_ns or "
+                                   "AlignmentOptions::n_align)",
                                    method, kMinPairs, n));
   }
 }
@@ -77,7 +79,7 @@ Similarity SolveUmeyama(const Moments& m, Eigen::Index n, bool with_scale) {
   if ((d.array() > eps).count() < 2) {
     throw ComputeError(fmt::format(
         "Umeyama alignment is degenerate: the {} associated positions lie on a line or at one point (singular values "
-        "of their covariance {:.3g}, {:.3g}, {:.3g}); use --align none or origin, or more of the trajectory",
+        "of their covariance {:.3g}, {:.3g}, {:.3g}); use AlignmentOptions::method none or origin, or more of the trajectory",
         n, d[0], d[1], d[2]));
   }
   const Eigen::Matrix3d& U = svd.matrixU();
@@ -180,18 +182,25 @@ Similarity PositionYawAlignment(const Eigen::Ref<const Eigen::Matrix3Xd>& est,
   return SolvePositionYaw(MatrixMoments(est, ref));
 }
 
+void AlignmentOptions::Validate() const {
+  const OptionCheck check("AlignmentOptions");
+  check(n_align >= 0, "n_align", "must be positive, got {}", n_align);
+  check(n_align == 0 || method != AlignmentMethod::kNone, "n_align",
+        "needs AlignmentOptions::method (se3, sim3, scale, posyaw or full)");
+}
+
 AlignmentResult ComputeAlignment(const PairedStates& pairs, const AlignmentOptions& options) {
   AlignmentResult result;
   result.method = options.method;
   if (options.method == AlignmentMethod::kNone) return result;
-  if (options.n_align < 0) throw UsageError(fmt::format("--n-align must be positive, got {}", options.n_align));
+  options.Validate();
   const Eigen::Index n = options.n_align > 0 ? std::min(options.n_align, pairs.size()) : pairs.size();
   result.pairs_used = n;
   if (options.method == AlignmentMethod::kOrigin) {
     if (n < 1) throw ComputeError("origin alignment needs at least one associated pair");
     if (!pairs.has_reference_orientation() || !pairs.has_estimate_orientation()) {
       throw ComputeError("origin alignment needs the orientation of both trajectories (one is position only); use "
-                         "--align se3 or posyaw");
+                         "AlignmentOptions::method se3 or posyaw");
     }
     // T = T_ref,0 · T_est,0⁻¹ (the inverse by transpose).
     const Eigen::Matrix3d r_est = pairs.RawEstimateRotation(0);

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "cheval/common/error.h"
+#include "cheval/common/options.h"
 #include "cheval/traj/stamp.h"
 
 namespace cheval::eval {
@@ -54,11 +55,25 @@ int64_t SecondsToNanoseconds(double seconds, const std::string& what) {
   return static_cast<int64_t>(ns);
 }
 
+AssociationOptions AssociationOptions::FromSeconds(double max_diff_s, double offset_s) {
+  const OptionCheck check("AssociationOptions");
+  auto usable = [](double seconds) { return std::isfinite(seconds) && std::abs(std::round(seconds * 1e9)) < 9.2e18; };
+  check(usable(max_diff_s), "max_diff_ns", "must be a usable time, got {} s", max_diff_s);
+  check(usable(offset_s), "offset_ns", "must be a usable time, got {} s", offset_s);
+  AssociationOptions options;
+  options.max_diff_ns = SecondsToNanoseconds(max_diff_s, "AssociationOptions::max_diff_ns");
+  options.offset_ns = SecondsToNanoseconds(offset_s, "AssociationOptions::offset_ns");
+  return options;
+}
+
+void AssociationOptions::Validate() const {
+  const OptionCheck check("AssociationOptions");
+  check(max_diff_ns >= 0, "max_diff_ns", "must be >= 0, got {} s", traj::FormatSeconds(max_diff_ns));
+}
+
 Association AssociateStamps(std::span<const int64_t> ref_stamps_ns, std::span<const int64_t> est_stamps_ns,
                             const AssociationOptions& options) {
-  if (options.max_diff_ns < 0) {
-    throw UsageError(fmt::format("--t-max-diff must be >= 0, got {} s", traj::FormatSeconds(options.max_diff_ns)));
-  }
+  options.Validate();
   // evo iterates over the shorter list (the estimate when the lengths are equal) and searches the
   // other, shifted into the shorter one's time: reference - offset, or estimate + offset.
   const bool est_longer = est_stamps_ns.size() > ref_stamps_ns.size();
@@ -122,7 +137,7 @@ Association Associate(const traj::TrajectoryView& ref, const traj::TrajectoryVie
     if (ref.size() != est.size()) {
       throw ComputeError(fmt::format(
           "the reference has {} poses and the estimate {}: without stamps (KITTI) pose i is compared with pose i, "
-          "so the files must have the same length (give stamps with --ref-kitti-times / --est-kitti-times to "
+          "so the files must have the same length (give each file its stamps with ReadOptions::kitti_times_path to "
           "associate by time)",
           ref.size(), est.size()));
     }
@@ -136,8 +151,9 @@ Association Associate(const traj::TrajectoryView& ref, const traj::TrajectoryVie
   Association result = AssociateStamps(ref.stamps_ns(), est.stamps_ns(), options);
   if (result.empty()) {
     throw ComputeError(fmt::format(
-        "no estimate stamp is within --t-max-diff {} s of a reference stamp (with --t-offset {} s): reference "
-        "stamps span {}, estimate stamps span {}. If the clocks differ, give --t-offset (est + offset = ref); if "
+        "no estimate stamp is within AssociationOptions::max_diff_ns {} s of a reference stamp (with "
+        "AssociationOptions::offset_ns {} s): reference stamps span {}, estimate stamps span {}. If the clocks "
+        "differ, give AssociationOptions::offset_ns (est + offset = ref); if "
         "the ranges differ by a factor of 1000 or 1e9, one file is in other units (ms, ns) than its format says",
         traj::ToSeconds(options.max_diff_ns), traj::ToSeconds(options.offset_ns), Range(ref.stamps_ns()),
         Range(est.stamps_ns())));

@@ -8,6 +8,8 @@
 
 #include "cheval/cheb/curve.h"
 #include "cheval/common/error.h"
+#include "cheval/common/options.h"
+#include "cheval/traj/stamp.h"
 #include "enum_names.h"
 
 namespace cheval::eval {
@@ -50,8 +52,8 @@ std::string ProvideReferenceVelocity(PairedStates& pairs, const EvaluationOption
     case ReferenceVelocitySource::kAuto:
     case ReferenceVelocitySource::kGiven:
       if (!ref.has_velocity()) {
-        throw ComputeError("--gt-velocity given: the reference has no velocity columns (use --gt-velocity chebyshev "
-                           "to derive it from its positions)");
+        throw ComputeError("EvaluationOptions::reference_velocity given: the reference has no velocity columns (use "
+                           "EvaluationOptions::reference_velocity chebyshev to derive it from its positions)");
       }
       return "given";
     case ReferenceVelocitySource::kChebyshev: {
@@ -82,9 +84,9 @@ traj::Trajectory ContinuousReference(const traj::TrajectoryView& ref, const traj
                                      const cheb::CurveOptions& curve_options, int64_t offset_ns,
                                      Association* association) {
   const std::span<const int64_t> ref_stamps = ref.stamps_ns();
-  if (!ref.has_stamps() || !est.has_stamps()) throw ComputeError("--association continuous needs stamps in both files");
+  if (!ref.has_stamps() || !est.has_stamps()) throw ComputeError("EvaluationOptions::continuous_reference needs stamps in both files");
   if (!std::is_sorted(ref_stamps.begin(), ref_stamps.end())) {
-    throw ComputeError("--association continuous needs the reference's stamps in increasing order");
+    throw ComputeError("EvaluationOptions::continuous_reference needs the reference's stamps in increasing order");
   }
   const Eigen::MatrixXd positions = ref.positions().transpose();
   const cheb::Curve curve = cheb::FitCurve(ref_stamps, positions, curve_options);
@@ -103,7 +105,8 @@ traj::Trajectory ContinuousReference(const traj::TrajectoryView& ref, const traj
     stamps.push_back(stamp);
   }
   if (stamps.empty()) {
-    throw ComputeError("--association continuous: no estimate stamp lies within the time covered by the reference");
+    throw ComputeError(
+        "EvaluationOptions::continuous_reference: no estimate stamp lies within the time covered by the reference");
   }
   Eigen::MatrixXd values, derivatives;
   curve.EvaluateMany(stamps, 1, &values, &derivatives);
@@ -157,29 +160,27 @@ std::optional<ReferenceVelocitySource> ReferenceVelocitySourceFromString(std::st
   return detail::ValueOf(kVelocitySourceNames, name);
 }
 
-void ValidateEvaluationOptions(const EvaluationOptions& options) {
-  if (options.association.max_diff_ns < 0) throw UsageError("--t-max-diff must be >= 0");
-  if (options.alignment.n_align < 0) {
-    throw UsageError(fmt::format("--n-align must be positive, got {}", options.alignment.n_align));
-  }
-  if (options.alignment.n_align > 0 && options.alignment.method == AlignmentMethod::kNone) {
-    throw UsageError("--n-align needs --align (se3, sim3, scale, posyaw or full)");
-  }
-  if (options.pose_only && options.estimate_velocity_body_frame) {
-    throw UsageError("--pose-only ignores velocity: drop --velocity-frame");
-  }
+void EvaluationOptions::Validate() const {
+  association.Validate();
+  alignment.Validate();
+  if (metric == MetricKind::kRpe) rpe.Validate();
+  velocity.Validate();
+  const OptionCheck check("EvaluationOptions");
+  check(!(pose_only && estimate_velocity_body_frame), "pose_only",
+        "ignores velocity: drop EvaluationOptions::estimate_velocity_body_frame");
+  check(!continuous_reference || reference_velocity == ReferenceVelocitySource::kAuto ||
+            reference_velocity == ReferenceVelocitySource::kChebyshev,
+        "continuous_reference",
+        "takes the reference velocity from its Chebyshev curve: use EvaluationOptions::reference_velocity auto or "
+        "chebyshev");
 }
 
 EvaluationResult Evaluate(const traj::TrajectoryView& ref, const traj::TrajectoryView& est,
                           const EvaluationOptions& options) {
+  options.Validate();
   EvaluationResult result;
   result.metric = options.metric;
   if (options.continuous_reference) {
-    if (options.reference_velocity == ReferenceVelocitySource::kGiven ||
-        options.reference_velocity == ReferenceVelocitySource::kCentral) {
-      throw UsageError("--association continuous takes the reference velocity from its Chebyshev curve: use "
-                       "--gt-velocity auto or chebyshev");
-    }
     result.continuous_reference =
         ContinuousReference(ref, est, options.velocity.curve, options.association.offset_ns, &result.association);
   } else {
@@ -192,7 +193,8 @@ EvaluationResult Evaluate(const traj::TrajectoryView& ref, const traj::Trajector
     if (!options.pose_only) {
       if (!est.has_velocity()) {
         throw ComputeError("ASE needs the estimate's velocity and it has none: give a file with velocity columns "
-                           "(tumv, euroc, vins, or csv with vx,vy,vz), or ask for the pose-only ASE with --pose-only");
+                           "(tumv, euroc, vins, or csv with vx,vy,vz), or ask for the pose-only ASE with "
+                           "EvaluationOptions::pose_only");
       }
       pairs.SetEstimateVelocityInBodyFrame(options.estimate_velocity_body_frame);
       result.velocity_source =
@@ -262,7 +264,9 @@ Json ReportJson(const EvaluationReport& report) {
   j["command"] = std::string(ToString(r.metric));
   j["reference"] = {{"path", report.reference_path}, {"poses", report.reference_poses}};
   j["estimate"] = {{"path", report.estimate_path}, {"poses", report.estimate_poses}};
-  j["association"] = {{"pairs", r.association.size()}, {"max_diff", report.max_diff_s}, {"offset", report.offset_s}};
+  j["association"] = {{"pairs", r.association.size()},
+                      {"max_diff", options.association.max_diff_s()},
+                      {"offset", options.association.offset_s()}};
   j["association"]["method"] = r.association.by_index          ? "index"
                                : options.continuous_reference ? "continuous"
                                                               : "nearest";
@@ -307,6 +311,39 @@ std::string EvaluationJson(std::span<const EvaluationReport> reports) {
   Json all = Json::array();
   for (const EvaluationReport& report : reports) all.push_back(ReportJson(report));
   return (all.size() == 1 ? all[0] : all).dump(2) + "\n";
+}
+
+std::string EvaluationErrorsCsv(std::span<const EvaluationReport> reports) {
+  if (reports.empty()) return "";
+  const bool several = reports.size() > 1;
+  const EvaluationResult& first = reports.front().result;
+  const bool rpe = first.metric == MetricKind::kRpe;
+  std::string header = several ? "estimate," : "";
+  header += rpe ? "stamp,stamp_end,error" : "stamp,error";
+  if (first.ase) {
+    if (first.ase->has_rotation) header += ",rotation";
+    header += ",position";
+    if (first.ase->has_velocity) header += ",velocity";
+  }
+  fmt::memory_buffer out;
+  auto it = std::back_inserter(out);
+  fmt::format_to(it, "{}\n", header);
+  for (const EvaluationReport& report : reports) {
+    const EvaluationResult& r = report.result;
+    for (size_t k = 0; k < r.errors.size(); ++k) {
+      if (several) fmt::format_to(it, "{},", report.estimate_path);
+      fmt::format_to(it, "{}", traj::FormatSeconds(r.stamps_ns[k]));
+      if (rpe) fmt::format_to(it, ",{}", traj::FormatSeconds(r.stamps_end_ns[k]));
+      fmt::format_to(it, ",{}", r.errors[k]);
+      if (r.ase) {
+        if (r.ase->has_rotation) fmt::format_to(it, ",{}", r.ase->rotation[k]);
+        fmt::format_to(it, ",{}", r.ase->position[k]);
+        if (r.ase->has_velocity) fmt::format_to(it, ",{}", r.ase->velocity[k]);
+      }
+      fmt::format_to(it, "\n");
+    }
+  }
+  return fmt::to_string(out);
 }
 
 }  // namespace cheval::eval

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "cheval/common/error.h"
+#include "cheval/common/options.h"
 #include "enum_names.h"
 
 namespace cheval::eval {
@@ -48,7 +49,7 @@ constexpr detail::NameTable<PoseRelation, 6, 3> kRelationNames{{
     {PoseRelation::kPointDistance, {"point_distance", "point distance", "m"}},
 }};
 
-// --delta-unit name and evo's label.
+// The unit's name and evo's label.
 constexpr detail::NameTable<DeltaUnit, 4, 2> kDeltaUnitNames{{
     {DeltaUnit::kFrames, {"frames", "frames"}},
     {DeltaUnit::kMeters, {"meters", "m"}},
@@ -249,19 +250,36 @@ std::vector<double> ApeErrors(const PairedStates& pairs, PoseRelation relation) 
 }
 
 std::string_view ToString(DeltaUnit unit) { return detail::TextOf(kDeltaUnitNames, unit); }
-std::optional<DeltaUnit> DeltaUnitFromString(std::string_view name) { return detail::ValueOf(kDeltaUnitNames, name); }
+std::optional<DeltaUnit> DeltaUnitFromString(std::string_view name) {
+  // evo's one-letter names first: "m" is both evo's letter for meters and the label of kMeters.
+  if (name.size() == 1) {
+    for (const auto& [unit, texts] : kDeltaUnitNames) {
+      if (texts[0].front() == name.front()) return unit;
+    }
+    return std::nullopt;
+  }
+  return detail::ValueOf(kDeltaUnitNames, name);
+}
 std::string_view DeltaUnitLabel(DeltaUnit unit) { return detail::TextOf(kDeltaUnitNames, unit, 1); }
 
+void RpeOptions::Validate() const {
+  const OptionCheck check("RpeOptions");
+  check(delta > 0 && std::isfinite(delta), "delta", "must be positive, got {}", delta);
+  check(delta_unit != DeltaUnit::kFrames || delta == std::floor(delta), "delta",
+        "must be an integer for RpeOptions::delta_unit frames, got {}", delta);
+  const bool degrees = delta_unit == DeltaUnit::kDegrees;
+  check(!(degrees || delta_unit == DeltaUnit::kRadians) || delta <= (degrees ? 180.0 : std::numbers::pi), "delta",
+        "must be within [0, {}] for RpeOptions::delta_unit {}, got {}", degrees ? "180" : "pi", ToString(delta_unit),
+        delta);
+}
+
 std::vector<IndexPair> RpeIndexPairs(const PairedStates& pairs, const RpeOptions& options) {
+  options.Validate();
   const double delta = options.delta;
-  if (!(delta > 0) || !std::isfinite(delta)) throw UsageError(fmt::format("--delta must be positive, got {}", delta));
   const Eigen::Index n = pairs.size();
   std::vector<IndexPair> out;
   switch (options.delta_unit) {
     case DeltaUnit::kFrames: {
-      if (delta != std::floor(delta)) {
-        throw UsageError(fmt::format("--delta must be an integer for --delta-unit frames, got {}", delta));
-      }
       const Eigen::Index step = delta < 9e18 ? static_cast<Eigen::Index>(delta) : n;
       if (options.all_pairs) {
         for (Eigen::Index i = 0; i < n - step; ++i) out.push_back({i, i + step});
@@ -278,20 +296,17 @@ std::vector<IndexPair> RpeIndexPairs(const PairedStates& pairs, const RpeOptions
     case DeltaUnit::kDegrees:
     case DeltaUnit::kRadians: {
       const bool degrees = options.delta_unit == DeltaUnit::kDegrees;
-      if (delta > (degrees ? 180.0 : std::numbers::pi)) {
-        throw UsageError(fmt::format("--delta must be within [0, {}] for --delta-unit {}, got {}",
-                                     degrees ? "180" : "pi", ToString(options.delta_unit), delta));
-      }
-      RequireOrientation(pairs, "RPE with an angular --delta-unit");
+      RequireOrientation(pairs, "RPE with an angular RpeOptions::delta_unit");
       const double to_rad = degrees ? std::numbers::pi / 180.0 : 1.0;  // numpy.deg2rad
       out = PairsByAngle(pairs, delta * to_rad, delta * options.relative_delta_tolerance * to_rad, options.all_pairs);
       break;
     }
   }
   if (out.empty()) {
-    throw ComputeError(fmt::format("RPE: --delta {} {} gives no pair of poses among the {} associated ones; try a "
-                                   "smaller --delta{}",
-                                   delta, ToString(options.delta_unit), n, options.all_pairs ? "" : " or --all-pairs"));
+    throw ComputeError(fmt::format("RPE: RpeOptions::delta {} {} gives no pair of poses among the {} associated ones; "
+                                   "try a smaller RpeOptions::delta{}",
+                                   delta, ToString(options.delta_unit), n,
+                                   options.all_pairs ? "" : " or RpeOptions::all_pairs"));
   }
   return out;
 }
@@ -364,12 +379,14 @@ AseErrors AseErrorsOf(const PairedStates& pairs, bool use_velocity) {
     throw ComputeError(fmt::format(
         "ASE needs velocity and the {} has none{}", pairs.has_estimate_velocity() ? "reference" : "estimate",
         pairs.has_estimate_velocity()
-            ? " (use --gt-velocity chebyshev or central to derive it from the reference positions)"
-            : " (give a file with velocity columns, e.g. tumv/euroc/vins, or ask for the pose-only ASE with --pose-only)"));
+            ? " (use EvaluationOptions::reference_velocity chebyshev or central to derive it from the reference "
+              "positions)"
+            : " (give a file with velocity columns, e.g. tumv/euroc/vins, or ask for the pose-only ASE with "
+              "EvaluationOptions::pose_only)"));
   }
   if (!pairs.has_estimate_orientation() && pairs.has_reference_orientation()) {
-    throw ComputeError("ASE: the estimate has no orientation; give the reference as position only (--ref-columns "
-                       "without quaternions) to compare position and velocity alone");
+    throw ComputeError("ASE: the estimate has no orientation; give the reference as position only (its "
+                       "ReadOptions::columns without quaternions) to compare position and velocity alone");
   }
   ase.has_rotation = pairs.has_reference_orientation() && pairs.has_estimate_orientation();
   const Eigen::Index n = pairs.size();

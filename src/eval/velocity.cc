@@ -1,12 +1,15 @@
 #include "cheval/eval/velocity.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 
 #include <Eigen/Cholesky>
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "cheval/common/error.h"
+#include "cheval/common/options.h"
 #include "cheval/lie/so3.h"
 
 namespace cheval::eval {
@@ -16,7 +19,7 @@ void RequireIncreasing(std::span<const int64_t> stamps, std::string_view method)
   for (size_t i = 1; i < stamps.size(); ++i) {
     if (stamps[i] <= stamps[i - 1]) {
       throw ComputeError(fmt::format("{} needs strictly increasing stamps; pose {} has a stamp <= the previous one "
-                                     "(use --method chebyshev, which handles them)",
+                                     "(use VelocityOptions::method chebyshev, which handles them)",
                                      method, i + 1));
     }
   }
@@ -53,9 +56,6 @@ Eigen::Matrix3Xd CentralAngularDifferences(const traj::TrajectoryView& trajector
 
 Eigen::Matrix3Xd SavitzkyGolay(const traj::TrajectoryView& trajectory, int window) {
   const Eigen::Index n = trajectory.size();
-  if (window < 5 || window % 2 == 0) {
-    throw UsageError(fmt::format("the Savitzky-Golay window must be an odd number of samples >= 5, got {}", window));
-  }
   if (n < window) {
     throw ComputeError(fmt::format("Savitzky-Golay with a {}-sample window needs at least {} poses, got {}", window,
                                    window, n));
@@ -104,23 +104,86 @@ std::optional<VelocityMethod> VelocityMethodFromString(std::string_view name) {
   return std::nullopt;
 }
 
+void VelocityOptions::Validate() const {
+  const OptionCheck check("VelocityOptions");
+  if (method == VelocityMethod::kSavitzkyGolay) {
+    if (savgol_window_s) {
+      check(*savgol_window_s > 0 && std::isfinite(*savgol_window_s), "savgol_window_s",
+            "must be a positive number of seconds, got {}", *savgol_window_s);
+    } else {
+      check(savgol_window >= 5 && savgol_window % 2 == 1, "savgol_window",
+            "must be an odd number of samples >= 5, got {}", savgol_window);
+    }
+  }
+  check(!angular || method != VelocityMethod::kSavitzkyGolay, "angular",
+        "works with VelocityOptions::method chebyshev or central, not {}", ToString(method));
+}
+
+namespace {
+
+// The degree names of CurveOptionsFromNames besides a fixed degree ("cv" is read as "auto").
+constexpr std::pair<std::string_view, cheb::DegreeMethod> kDegreeNames[] = {
+    {"auto", cheb::DegreeMethod::kCrossValidation},
+    {"chop", cheb::DegreeMethod::kChop},
+};
+
+}  // namespace
+
+cheb::CurveOptions CurveOptionsFromNames(std::string_view degree, std::optional<double> window_s) {
+  cheb::CurveOptions options;
+  options.window_s = window_s;
+  const std::string_view name = degree == "cv" ? "auto" : degree;
+  for (const auto& [text, method] : kDegreeNames) {
+    if (text == name) {
+      options.degree_method = method;
+      return options;
+    }
+  }
+  int fixed = -1;
+  const auto [end, ec] = std::from_chars(degree.data(), degree.data() + degree.size(), fixed);
+  const OptionCheck check("CurveOptions");
+  check(ec == std::errc() && end == degree.data() + degree.size() && fixed >= 0, "degree_method",
+        "must be auto, cv, chop or a non-negative integer, got '{}'", degree);
+  options.degree_method = cheb::DegreeMethod::kFixed;
+  options.fixed_degree = fixed;
+  options.single_window = !window_s.has_value();  // a fixed degree alone: one global fit
+  return options;
+}
+
+std::string DegreeName(const cheb::CurveOptions& options) {
+  for (const auto& [text, method] : kDegreeNames) {
+    if (method == options.degree_method) return std::string(text);
+  }
+  return std::to_string(options.fixed_degree);
+}
+
+int SavitzkyGolaySamples(std::span<const int64_t> stamps_ns, double window_s) {
+  if (stamps_ns.empty()) return 5;
+  const double duration = static_cast<double>(stamps_ns.back() - stamps_ns.front()) * 1e-9;
+  const double rate = duration > 0 ? static_cast<double>(stamps_ns.size() - 1) / duration : 0.0;
+  int samples = static_cast<int>(std::lround(window_s * rate));
+  if (samples % 2 == 0) ++samples;
+  return std::max(samples, 5);
+}
+
 VelocityEstimate EstimateVelocity(const traj::TrajectoryView& trajectory, const VelocityOptions& options,
                                   std::optional<std::span<const int64_t>> at_ns) {
+  options.Validate();
   VelocityEstimate estimate;
-  if (options.angular && !trajectory.has_orientation()) {
-    throw UsageError("--angular needs orientations, but the trajectory has positions only");
+  if (!trajectory.has_stamps()) {
+    throw ComputeError("velocity needs stamps; give the KITTI times with ReadOptions::kitti_times_path");
   }
+  const OptionCheck check("VelocityOptions");
+  check(!options.angular || trajectory.has_orientation(), "angular",
+        "needs orientations, but the trajectory has positions only");
   if (options.method != VelocityMethod::kChebyshev) {
-    if (at_ns) {
-      throw UsageError(fmt::format("--at needs --method chebyshev: {} gives velocity only at the input's own stamps",
-                                   ToString(options.method)));
-    }
-    if (options.angular && options.method != VelocityMethod::kCentral) {
-      throw UsageError(fmt::format("--angular works with --method chebyshev or central, not {}",
-                                   ToString(options.method)));
-    }
+    check(!at_ns, "method", "must be chebyshev to evaluate at other stamps: {} gives velocity only at the input's own "
+          "stamps", ToString(options.method));
+    const int savgol_window = options.savgol_window_s
+                                  ? SavitzkyGolaySamples(trajectory.stamps_ns(), *options.savgol_window_s)
+                                  : options.savgol_window;
     estimate.velocities = options.method == VelocityMethod::kCentral ? CentralDifferences(trajectory)
-                                                                      : SavitzkyGolay(trajectory, options.savgol_window);
+                                                                      : SavitzkyGolay(trajectory, savgol_window);
     if (options.angular) estimate.angular_velocities = CentralAngularDifferences(trajectory);
     return estimate;
   }
@@ -142,6 +205,80 @@ VelocityEstimate EstimateVelocity(const traj::TrajectoryView& trajectory, const 
     estimate.rotation_curve = std::move(rotation);
   }
   return estimate;
+}
+
+traj::Trajectory VelocityTrajectory(const traj::TrajectoryView& input, const VelocityEstimate& estimate,
+                                    std::optional<std::span<const int64_t>> at_ns) {
+  const bool own = !at_ns.has_value();
+  const std::span<const int64_t> stamps = own ? input.stamps_ns() : *at_ns;
+  const bool angular = estimate.angular_velocities.cols() > 0;
+  traj::Trajectory out(traj::Channels{traj::OrientationKind::kQuaternion, true, angular, true});
+  out.Reserve(static_cast<Eigen::Index>(stamps.size()));
+  for (size_t i = 0; i < stamps.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    Eigen::Vector3d position;
+    Eigen::Vector4d q(0, 0, 0, 1);
+    if (own) {
+      position = input.positions().col(k);
+      if (input.channels().orientation == traj::OrientationKind::kQuaternion) {
+        q = input.quaternions().col(k);
+      } else if (input.has_orientation()) {
+        q = input.UnitQuaternion(k).coeffs();
+      }
+    } else {
+      position = estimate.positions.col(k);
+      if (!estimate.orientations.empty()) {
+        q = estimate.orientations[i].coeffs();  // the fitted orientation curve
+      } else if (input.has_orientation()) {
+        // Slerp between the input's neighbouring orientations.
+        const auto s = input.stamps_ns();
+        const auto upper = std::upper_bound(s.begin(), s.end(), stamps[i]) - s.begin();
+        const Eigen::Index j1 = std::clamp<Eigen::Index>(upper, 1, input.size() - 1), j0 = j1 - 1;
+        const double span = static_cast<double>(s[j1] - s[j0]);
+        const double f = span > 0 ? std::clamp(static_cast<double>(stamps[i] - s[j0]) / span, 0.0, 1.0) : 0.0;
+        q = input.UnitQuaternion(j0).slerp(f, input.UnitQuaternion(j1)).coeffs();
+      }
+    }
+    const Eigen::Vector3d v = estimate.velocities.col(k);
+    Eigen::Vector3d w = Eigen::Vector3d::Zero();
+    if (angular) w = estimate.angular_velocities.col(k);
+    out.Append(stamps[i], position.data(), q.data(), v.data(), w.data());
+  }
+  return out;
+}
+
+std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimate) {
+  nlohmann::json j;  // keys sorted, as the file has always been written
+  j["command"] = "velocity";
+  j["input"] = {{"path", run.input_path}, {"poses", run.input_poses}};
+  j["method"] = std::string(ToString(run.options.method));
+  j["evaluated_at"] = run.evaluated_at;
+  if (estimate.curve) {
+    const cheb::Curve& curve = *estimate.curve;
+    nlohmann::json windows = nlohmann::json::array();
+    std::vector<int> degrees;
+    for (const cheb::CurveSegment& segment : curve.segments()) {
+      for (const cheb::CurveWindow& w : segment.windows) {
+        windows.push_back(
+            {{"begin_s", w.fit_begin}, {"end_s", w.fit_end}, {"samples", w.samples}, {"degrees", w.degrees}});
+        degrees.insert(degrees.end(), w.degrees.begin(), w.degrees.end());
+      }
+    }
+    j["degree_method"] = DegreeName(run.options.curve);
+    j["segments"] = curve.segments().size();
+    j["windows"] = windows.size();
+    j["degrees"] = degrees;
+    j["window_list"] = windows;
+    j["noise_sigma_m"] = std::vector<double>(curve.noise_sigma().data(), curve.noise_sigma().data() + 3);
+    j["residual_rmse_m"] = std::vector<double>(curve.residual_rms().data(), curve.residual_rms().data() + 3);
+    j["compression_ratio"] = static_cast<double>(3 * run.input_poses) / static_cast<double>(curve.stored_values());
+  }
+  if (estimate.rotation_curve) {
+    j["angular"] = {{"charts", estimate.rotation_curve->charts().size()},
+                    {"residual_rms_rad", estimate.rotation_curve->residual_rms_rad()}};
+  }
+  j["seconds"] = run.seconds;
+  return j.dump(2) + "\n";
 }
 
 }  // namespace cheval::eval

@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cheval/common/error.h"
+#include "cheval/common/option_names.h"
+#include "cheval/common/options.h"
 #include "cheval/eval/pairs.h"
 #include "cheval/eval/velocity.h"
 #include "cheval/report/decimate.h"
@@ -134,15 +136,12 @@ AlignedStates Aligned(const traj::TrajectoryView& est, const eval::Similarity& a
 }
 
 eval::EvaluationReport Evaluated(const ReportInput& reference, const ReportInput& estimate,
-                                 const eval::EvaluationOptions& evaluation, eval::MetricKind metric,
-                                 const ReportOptions& options) {
+                                 const eval::EvaluationOptions& evaluation, eval::MetricKind metric) {
   eval::EvaluationReport e;
   e.reference_path = reference.path;
   e.reference_poses = reference.trajectory.size();
   e.estimate_path = estimate.path;
   e.estimate_poses = estimate.trajectory.size();
-  e.max_diff_s = options.max_diff_s;
-  e.offset_s = options.offset_s;
   e.options = evaluation;
   e.options.metric = metric;
   e.result = eval::Evaluate(reference.trajectory, estimate.trajectory, e.options);
@@ -224,7 +223,8 @@ Json ReferenceVelocity(const ReportInput& reference, const ReportOptions& option
       velocity[name] = TimeSeries(t, VelocityColumns(estimate.velocities), options.max_points);
       if (estimate.curve) *fit = FitDiagnostics(*estimate.curve, clock, options.max_fit_windows);
     } catch (const ComputeError& e) {
-      notes->push_back(fmt::format("the reference velocity by {} cannot be shown: {}", name, e.what()));
+      notes->push_back(fmt::format("the reference velocity by {} cannot be shown: {}", name,
+                                   SpellOptions(e.what(), options.option_names)));
     }
   }
   if (ref.has_velocity()) velocity["given"] = TimeSeries(t, VelocityColumns(ref.velocities()), options.max_points);
@@ -233,11 +233,17 @@ Json ReferenceVelocity(const ReportInput& reference, const ReportOptions& option
 
 }  // namespace
 
+void ReportOptions::Validate() const {
+  ape.Validate();
+  ase.Validate();
+  const OptionCheck check("ReportOptions");
+  check(max_points >= 16, "max_points", "must be at least 16, got {}", max_points);
+  check(max_fit_windows >= 1, "max_fit_windows", "must be at least 1, got {}", max_fit_windows);
+}
+
 Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>& estimates,
                    const ReportOptions& options) {
-  if (options.max_points < 16)
-    throw UsageError(fmt::format("--max-points must be at least 16, got {}", options.max_points));
-  if (options.max_fit_windows < 1) throw UsageError("the report needs at least one fit window's coefficients");
+  options.Validate();
   const traj::TrajectoryView& ref = reference.trajectory;
   Clock clock;
   clock.stamps = ref.has_stamps() && !ref.empty();
@@ -259,8 +265,8 @@ Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>&
   data["options"] = {{"align", std::string(eval::ToString(options.ape.alignment.method))},
                      {"n_align", options.ape.alignment.n_align},
                      {"relation", std::string(eval::ToString(options.ape.relation))},
-                     {"t_max_diff", options.max_diff_s},
-                     {"t_offset", options.offset_s},
+                     {"t_max_diff", options.ape.association.max_diff_s()},
+                     {"t_offset", options.ape.association.offset_s()},
                      {"association", options.ape.continuous_reference ? "continuous" : "nearest"},
                      {"gt_velocity", std::string(eval::ToString(options.ase.reference_velocity))},
                      {"velocity_frame", options.ase.estimate_velocity_body_frame ? "body" : "world"},
@@ -270,7 +276,7 @@ Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>&
   for (const ReportInput& estimate : estimates) {
     const traj::TrajectoryView& est = estimate.trajectory;
     const eval::EvaluationReport& ape =
-        report.ape.emplace_back(Evaluated(reference, estimate, options.ape, eval::MetricKind::kApe, options));
+        report.ape.emplace_back(Evaluated(reference, estimate, options.ape, eval::MetricKind::kApe));
     Json entry;
     entry["path"] = estimate.path;
     entry["poses"] = est.size();
@@ -289,11 +295,11 @@ Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>&
           estimate.path));
     } else {
       try {
-        ase = Evaluated(reference, estimate, options.ase, eval::MetricKind::kAse, options);
+        ase = Evaluated(reference, estimate, options.ase, eval::MetricKind::kAse);
       } catch (const ComputeError& e) {
         absent = "no ASE";
         report.notes.push_back(fmt::format("the ASE of {} cannot be computed, so it is not shown: {}", estimate.path,
-                                           e.what()));
+                                           SpellOptions(e.what(), options.option_names)));
       }
     }
     if (ase) {
@@ -309,7 +315,7 @@ Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>&
       entry["ase_absent"] = absent;
     }
     if (est.has_velocity()) {
-      // The velocity the ASE scored: world frame (after --velocity-frame body), with the ASE's alignment
+      // The velocity the ASE scored: world frame (after a body-frame estimate velocity is rotated), with the ASE's alignment
       // (the APE's when there is no ASE).
       const eval::Similarity& alignment = (ase ? ase->result : ape.result).alignment.transform;
       const AlignedStates states = Aligned(est, alignment, true, options.ase.estimate_velocity_body_frame);

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "cheval/common/error.h"
+#include "cheval/common/options.h"
 #include "cheval/traj/io.h"
 
 namespace cheval::traj {
@@ -62,12 +63,12 @@ ColumnMap ColumnMap::Parse(std::string_view spec) {
                                  [&](const auto& entry) { return entry.second == token; });
     if (it == kRoleNames.end()) {
       throw UsageError(fmt::format(
-          "--columns: unknown column role '{}' (position {}); expected one of t, t_ms, t_us, t_ns, px, py, pz, "
+          "ReadOptions::columns: unknown column role '{}' (position {}); expected one of t, t_ms, t_us, t_ns, px, py, pz, "
           "qx, qy, qz, qw, roll, pitch, yaw, vx, vy, vz, wx, wy, wz, or _ to skip a column",
           token, map.roles.size() + 1));
     }
     if (it->first != ColumnRole::kSkip && !seen.insert(it->first).second) {
-      throw UsageError(fmt::format("--columns: role '{}' appears twice", token));
+      throw UsageError(fmt::format("ReadOptions::columns: role '{}' appears twice", token));
     }
     map.roles.push_back(it->first);
     if (comma == std::string_view::npos) break;
@@ -81,21 +82,21 @@ ColumnMap ColumnMap::Parse(std::string_view spec) {
   const int times = count({ColumnRole::kTimeSeconds, ColumnRole::kTimeMilliseconds, ColumnRole::kTimeMicroseconds,
                            ColumnRole::kTimeNanoseconds});
   if (times != 1) {
-    throw UsageError("--columns: expected exactly one time column (t, t_ms, t_us or t_ns)");
+    throw UsageError("ReadOptions::columns: expected exactly one time column (t, t_ms, t_us or t_ns)");
   }
   if (count({ColumnRole::kPx, ColumnRole::kPy, ColumnRole::kPz}) != 3) {
-    throw UsageError("--columns: expected all three position columns px, py, pz");
+    throw UsageError("ReadOptions::columns: expected all three position columns px, py, pz");
   }
   const int quaternion = count({ColumnRole::kQx, ColumnRole::kQy, ColumnRole::kQz, ColumnRole::kQw});
   const int euler = count({ColumnRole::kRoll, ColumnRole::kPitch, ColumnRole::kYaw});
-  if (quaternion != 0 && quaternion != 4) throw UsageError("--columns: give all of qx, qy, qz, qw or none");
-  if (euler != 0 && euler != 3) throw UsageError("--columns: give all of roll, pitch, yaw or none");
-  if (quaternion != 0 && euler != 0) throw UsageError("--columns: give a quaternion or roll/pitch/yaw, not both");
+  if (quaternion != 0 && quaternion != 4) throw UsageError("ReadOptions::columns: give all of qx, qy, qz, qw or none");
+  if (euler != 0 && euler != 3) throw UsageError("ReadOptions::columns: give all of roll, pitch, yaw or none");
+  if (quaternion != 0 && euler != 0) throw UsageError("ReadOptions::columns: give a quaternion or roll/pitch/yaw, not both");
   if (int v = count({ColumnRole::kVx, ColumnRole::kVy, ColumnRole::kVz}); v != 0 && v != 3) {
-    throw UsageError("--columns: give all of vx, vy, vz or none");
+    throw UsageError("ReadOptions::columns: give all of vx, vy, vz or none");
   }
   if (int w = count({ColumnRole::kWx, ColumnRole::kWy, ColumnRole::kWz}); w != 0 && w != 3) {
-    throw UsageError("--columns: give all of wx, wy, wz or none");
+    throw UsageError("ReadOptions::columns: give all of wx, wy, wz or none");
   }
   while (!map.roles.empty() && map.roles.back() == ColumnRole::kSkip) map.roles.pop_back();
   return map;
@@ -108,6 +109,27 @@ std::string ColumnMap::ToString() const {
     out += RoleName(roles[i]);
   }
   return out;
+}
+
+ReadOptions ReadOptions::FromNames(std::string_view format, std::string_view columns, std::string kitti_times_path) {
+  const OptionCheck check("ReadOptions");
+  ReadOptions options;
+  const std::optional<Format> parsed = FormatFromString(format);
+  check(parsed.has_value(), "format", "names an unknown format '{}' (auto, tum, tumv, euroc, kitti, vins, csv)", format);
+  options.format = *parsed;
+  if (!columns.empty()) {
+    check(options.format == Format::kCsv || options.format == Format::kAuto, "columns",
+          "is only for ReadOptions::format csv (got ReadOptions::format {})", format);
+    options.format = Format::kCsv;  // a column map implies the generic format
+    options.columns = ColumnMap::Parse(columns);
+  } else {
+    check(options.format != Format::kCsv, "format",
+          "csv needs ReadOptions::columns (e.g. ReadOptions::columns t,px,py,pz,qx,qy,qz,qw)");
+  }
+  check(kitti_times_path.empty() || options.format == Format::kKitti || options.format == Format::kAuto,
+        "kitti_times_path", "is only for KITTI files");
+  options.kitti_times_path = std::move(kitti_times_path);
+  return options;
 }
 
 }  // namespace cheval::traj

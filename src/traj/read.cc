@@ -577,7 +577,7 @@ Format DetectFormat(const std::string& path, std::string_view content) {
       throw InputError(path, scanner.line_number(), 1,
                        fmt::format("cannot detect the format: {} comma-separated fields{}; EuRoC needs a "
                                    "'#timestamp' or '#time' header, VINS integer nanosecond stamps and 8 or 11 fields. "
-                                   "Use --format csv --columns ... (e.g. t_ns,px,py,pz,qw,qx,qy,qz)",
+                                   "Use ReadOptions::format csv ReadOptions::columns ... (e.g. t_ns,px,py,pz,qw,qx,qy,qz)",
                                    count, header ? " after a header row" : ""));
     }
     if (count == 8 || count == 11 || count == 14) {
@@ -594,7 +594,8 @@ Format DetectFormat(const std::string& path, std::string_view content) {
       throw InputError(path, header_line, named ? header_fields[*wrong].column : 1,
                        fmt::format("cannot detect the format: {} space-separated fields after a header row that does "
                                    "not name {}'s columns ({}: a time first, then names ending in {}); {}. Use "
-                                   "--format {} if the columns are in that order, else --format csv --columns ...",
+                                   "ReadOptions::format {} if the columns are in that order, else ReadOptions::format csv "
+                                   "ReadOptions::columns ...",
                                    count, ToString(format), columns, axes,
                                    named ? fmt::format("its field {} is '{}'", *wrong + 1, header_fields[*wrong].text)
                                          : fmt::format("it has {} names", header_fields.size()),
@@ -604,12 +605,13 @@ Format DetectFormat(const std::string& path, std::string_view content) {
       if (!header) return Format::kKitti;
       throw InputError(path, scanner.line_number(), 1,
                        "cannot detect the format: 12 space-separated fields after a header row; KITTI files have no "
-                       "header. Use --format kitti if this is one, else --format csv --columns ...");
+                       "header. Use ReadOptions::format kitti if this is one, else ReadOptions::format csv "
+                       "ReadOptions::columns ...");
     }
     throw InputError(path, scanner.line_number(), 1,
                      fmt::format("cannot detect the format: {} space-separated fields{}; expected 8 (tum: t x y z qx "
-                                 "qy qz qw), 11 (tumv: ... vx vy vz), 12 (kitti) or 14 (tumv: ... vx vy vz wx wy wz). Use --format csv "
-                                 "--columns ...",
+                                 "qy qz qw), 11 (tumv: ... vx vy vz), 12 (kitti) or 14 (tumv: ... vx vy vz wx wy wz). Use "
+                                 "ReadOptions::format csv ReadOptions::columns ...",
                                  count, header ? " after a header row" : ""));
   }
   throw InputError(path, scanner.line_number() + 1, 1,
@@ -629,7 +631,8 @@ Trajectory ParseTrajectory(std::string_view content, const std::string& path, co
     case Format::kVins: layout = NanosecondCsvLayout(Format::kVins, false); layout.field_counts.clear(); break;
     case Format::kKitti: layout = KittiLayout(); break;
     case Format::kCsv: {
-      if (!options.columns) throw UsageError("--format csv needs --columns (e.g. --columns t,px,py,pz,qx,qy,qz,qw)");
+      if (!options.columns) throw UsageError(
+            "ReadOptions::format csv needs ReadOptions::columns (e.g. ReadOptions::columns t,px,py,pz,qx,qy,qz,qw)");
       // The separator is the file's: commas if its first data line has one, else whitespace.
       LineScanner probe(content);
       const char separator = probe.Next() && probe.line().find(',') != std::string_view::npos ? ',' : ' ';

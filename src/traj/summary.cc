@@ -5,6 +5,8 @@
 #include <numeric>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "cheval/traj/stamp.h"
 
 namespace cheval::traj {
@@ -91,6 +93,48 @@ TrajectorySummary Summarize(const TrajectoryView& trajectory) {
     }
   }
   return s;
+}
+
+namespace {
+
+nlohmann::json StatsJson(const BasicStats& s) {
+  return {{"mean", s.mean}, {"median", s.median}, {"min", s.min}, {"max", s.max}, {"std", s.std}, {"n", s.n}};
+}
+
+nlohmann::json FileJson(const FileSummary& file) {
+  const TrajectorySummary& s = file.summary;
+  nlohmann::json j;  // keys sorted
+  j["path"] = file.path;
+  j["format"] = std::string(ToString(file.format));
+  j["poses"] = s.poses;
+  j["has_stamps"] = s.has_stamps;
+  j["first_stamp_s"] = FormatSeconds(s.first_stamp_ns);
+  j["last_stamp_s"] = FormatSeconds(s.last_stamp_ns);
+  j["duration_s"] = s.duration_s;
+  j["rate_hz"] = s.rate_hz;
+  j["dt_s"] = StatsJson(s.dt_s);
+  j["gaps"] = s.gaps;
+  j["largest_gap_s"] = s.largest_gap_s;
+  j["path_length_m"] = s.path_length_m;
+  j["speed_mps"] = StatsJson(s.speed_mps);
+  j["speed_source"] = s.speed_from_velocity ? "velocity" : "finite_differences";
+  j["has_orientation"] = s.has_orientation;
+  j["has_velocity"] = s.has_velocity;
+  j["has_angular_velocity"] = s.has_angular_velocity;
+  j["duplicate_stamps"] = s.duplicate_stamps;
+  j["non_increasing_stamps"] = s.non_increasing_stamps;
+  j["non_unit_quaternions"] = s.non_unit_quaternions;
+  j["max_quaternion_norm_error"] = s.max_quaternion_norm_error;
+  j["max_orthonormality_error"] = s.max_orthonormality_error;
+  return j;
+}
+
+}  // namespace
+
+std::string SummaryJson(std::span<const FileSummary> files) {
+  nlohmann::json all = nlohmann::json::array();
+  for (const FileSummary& file : files) all.push_back(FileJson(file));
+  return (all.size() == 1 ? all[0] : all).dump(2) + "\n";
 }
 
 }  // namespace cheval::traj

@@ -1,5 +1,5 @@
 // `cheval ape | rpe | ase` end to end: hand-checkable values through the executable, the JSON keys of
-// METRICS.md §9, the per-pair CSV, the comparison table for several estimates, and every bad input
+// docs/evaluation.md ("Output"), the per-pair CSV, the comparison table for several estimates, and every bad input
 // of issue 4 with its documented exit code and no output file left behind.
 #include <sys/wait.h>
 #include <unistd.h>
@@ -76,7 +76,7 @@ class EvalCliTest : public ::testing::Test {
 };
 
 // An estimate shifted by 0.3 m along x: APE 0.3 everywhere without alignment, ~0 after SE(3); the
-// JSON has exactly the keys of METRICS.md §9; the CSV has one row per pair.
+// JSON has exactly the keys of docs/evaluation.md ("Output"); the CSV has one row per pair.
 TEST_F(EvalCliTest, ApeHandCheckedJsonAndCsv) {
   const std::string ref = Helix("ref.txt", 10), est = Helix("est.txt", 10, {0.3, 0, 0});
   const Output run = Run(fmt::format("ape {} {} --json {} --errors {}", ref, est, File("r.json"), File("e.csv")));
@@ -233,7 +233,34 @@ TEST_F(EvalCliTest, BadInputExitCodesAndNoPartialOutput) {
   EXPECT_EQ(entries, 7u);  // ref, est, far, a.kitti, b.kitti, pa, pb
 }
 
-// The shared evo files: V1_02 gives evo's 798 pairs (METRICS.md §2), KITTI 00 the drift over every
+// A bad option is reported with the flag the user typed (the library names the options field;
+// tools/cheval/option_names.cc spells it), exit 1, before any file is read or written.
+TEST_F(EvalCliTest, OptionErrorsNameTheFlag) {
+  const std::string ref = Helix("r.txt", 2), est = Helix("e.txt", 2, {0.1, 0, 0});
+  const std::string json = " --json " + File("r.json");
+  const std::pair<std::string, std::string> cases[] = {
+      {"ape {} {} --n-align 5", "--n-align needs --align (se3, sim3, scale, posyaw or full)"},
+      {"ape {} {} --t-max-diff -1", "--t-max-diff must be >= 0, got -1.000000000 s"},
+      {"rpe {} {} --delta 1.5", "--delta must be an integer for --delta-unit frames, got 1.5"},
+      {"ase {} {} --pose-only --velocity-frame body", "--pose-only ignores velocity: drop --velocity-frame"},
+      {"ase {} {} --association continuous --gt-velocity given",
+       "--association continuous takes the reference velocity from its Chebyshev curve: use --gt-velocity auto or "
+       "chebyshev"},
+      {"ape {} {}.missing --n-align -2 --align se3", "--n-align must be positive, got -2"},
+  };
+  for (const auto& [args, message] : cases) {
+    const Output run = Run(fmt::format(fmt::runtime(args), ref, est) + json);
+    EXPECT_EQ(run.code, 1) << args;
+    EXPECT_EQ(run.stderr_text, "cheval: error: " + message + "\n") << args;
+    EXPECT_FALSE(fs::exists(File("r.json")));
+  }
+  const Output degree = Run(fmt::format("velocity {} --degree foo", ref));
+  EXPECT_EQ(degree.code, 1);
+  EXPECT_EQ(degree.stderr_text,
+            "cheval: error: --degree must be auto, cv, chop or a non-negative integer, got 'foo'\n");
+}
+
+// The shared evo files: V1_02 gives evo's 798 pairs (docs/evaluation.md, "Association"), KITTI 00 the drift over every
 // segment length (evo's own numbers are checked by evo_parity_test.py).
 TEST_F(EvalCliTest, SharedEvoFiles) {
   CHEVAL_REQUIRE_SHARED_DATA();
@@ -241,7 +268,7 @@ TEST_F(EvalCliTest, SharedEvoFiles) {
   const Output v102 = Run(fmt::format("ape {}V102_groundtruth.csv {}V102.txt --align se3 --json {}", evo, evo,
                                       File("v.json")));
   ASSERT_EQ(v102.code, 0) << v102.stderr_text;
-  EXPECT_EQ(nlohmann::json::parse(Read(File("v.json")))["association"]["pairs"], 798);  // METRICS.md §2
+  EXPECT_EQ(nlohmann::json::parse(Read(File("v.json")))["association"]["pairs"], 798);  // docs/evaluation.md, "Association"
   const Output drift = Run(fmt::format("rpe {}KITTI_00_gt.txt {}KITTI_00_ORB.txt --delta 100 -u m --kitti-drift --json {}",
                                        evo, evo, File("k.json")));
   ASSERT_EQ(drift.code, 0) << drift.stderr_text;

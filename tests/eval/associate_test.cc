@@ -158,7 +158,8 @@ TEST(AssociateTest, NoPairsSaysBothRangesAndSuggestsOffsetOrUnits) {
   const traj::Trajectory est = MakeTrajectory({PoseSpec{5'000'000'000}, PoseSpec{6'000'000'000}});
   testing::ExpectThrowWith<ComputeError>([&] { Associate(ref.View(), est.View()); },
                                          {"reference stamps span 1.000000000 .. 2.000000000 s",
-                                          "estimate stamps span 5.000000000 .. 6.000000000 s", "--t-offset", "units"});
+                                          "estimate stamps span 5.000000000 .. 6.000000000 s",
+                                          "AssociationOptions::offset_ns", "units"});
   AssociationOptions shifted;
   shifted.offset_ns = -4'000'000'000;
   EXPECT_EQ(Associate(ref.View(), est.View(), shifted).size(), 2);
@@ -168,10 +169,10 @@ TEST(AssociateTest, NoPairsSaysBothRangesAndSuggestsOffsetOrUnits) {
 }
 
 TEST(AssociateTest, SecondsToNanosecondsRoundsAndRejectsNonFinite) {
-  EXPECT_EQ(SecondsToNanoseconds(0.01, "--t-max-diff"), 10'000'000);
-  EXPECT_EQ(SecondsToNanoseconds(-1.5, "--t-offset"), -1'500'000'000);
-  EXPECT_THROW(SecondsToNanoseconds(std::nan(""), "--t-offset"), UsageError);
-  EXPECT_THROW(SecondsToNanoseconds(1e12, "--t-offset"), UsageError);
+  EXPECT_EQ(SecondsToNanoseconds(0.01, "AssociationOptions::max_diff_ns"), 10'000'000);
+  EXPECT_EQ(SecondsToNanoseconds(-1.5, "AssociationOptions::offset_ns"), -1'500'000'000);
+  EXPECT_THROW(SecondsToNanoseconds(std::nan(""), "AssociationOptions::offset_ns"), UsageError);
+  EXPECT_THROW(SecondsToNanoseconds(1e12, "AssociationOptions::offset_ns"), UsageError);
 }
 
 }  // namespace

@@ -294,7 +294,7 @@ TEST(AseTest, ItselfIsZeroAndMissingVelocityIsAnError) {
   options.metric = MetricKind::kAse;
   for (double e : Evaluate(t.View(), t.View(), options).errors) ASSERT_LE(e, 1e-15);  // RᵀR = I to a few ulps
   const traj::Trajectory poses = MakeTrajectory(testing::PosesOf(t.View()), false);
-  testing::ExpectThrowWith<ComputeError>([&] { Evaluate(t.View(), poses.View(), options); }, {"--pose-only"});
+  testing::ExpectThrowWith<ComputeError>([&] { Evaluate(t.View(), poses.View(), options); }, {"EvaluationOptions::pose_only"});
   options.pose_only = true;
   const EvaluationResult pose_only = Evaluate(t.View(), poses.View(), options);
   EXPECT_EQ(pose_only.relation, "rotation+position");

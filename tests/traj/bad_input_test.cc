@@ -1,4 +1,5 @@
-// The broken files of tests/data/bad, each with the exact message a user sees.
+// The broken files of tests/data/bad, each with the exact message of the library (the faces spell its
+// ReadOptions::FIELD names as their flags and keywords).
 #include <cmath>
 #include <limits>
 #include <string>
@@ -29,7 +30,7 @@ const BadFile kBadFiles[] = {
     {"too_many_fields.txt", "tum", ":1:19", "expected 8 fields (t x y z qx qy qz qw), got 9"},
     {"too_many_fields.txt", "auto", ":1:1",
      "cannot detect the format: 9 space-separated fields; expected 8 (tum: t x y z qx qy qz qw), 11 (tumv: ... vx "
-     "vy vz), 12 (kitti) or 14 (tumv: ... vx vy vz wx wy wz). Use --format csv --columns ..."},
+     "vy vz), 12 (kitti) or 14 (tumv: ... vx vy vz wx wy wz). Use ReadOptions::format csv ReadOptions::columns ..."},
     {"not_a_number.txt", "auto", ":2:7", "expected a number for field 3 (y), got 'abc'"},
     {"nan.txt", "auto", ":1:9", "field 4 (z) is 'nan'; expected a finite number"},
     {"inf.txt", "auto", ":2:5", "field 2 (x) is 'inf'; expected a finite number"},
@@ -50,13 +51,13 @@ const BadFile kBadFiles[] = {
      "expected 8 fields (t_ns px py pz qw qx qy qz) or 11 (... vx vy vz), got 10"},
     {"vins_wrong_count.csv", "auto", ":1:1",
      "cannot detect the format: 10 comma-separated fields; EuRoC needs a '#timestamp' or '#time' header, VINS integer "
-     "nanosecond stamps and 8 or 11 fields. Use --format csv --columns ... (e.g. t_ns,px,py,pz,qw,qx,qy,qz)"},
+     "nanosecond stamps and 8 or 11 fields. Use ReadOptions::format csv ReadOptions::columns ... (e.g. t_ns,px,py,pz,qw,qx,qy,qz)"},
     {"undetectable.txt", "auto", ":1:1",
      "cannot detect the format: 5 space-separated fields; expected 8 (tum: t x y z qx qy qz qw), 11 (tumv: ... vx "
-     "vy vz), 12 (kitti) or 14 (tumv: ... vx vy vz wx wy wz). Use --format csv --columns ..."},
+     "vy vz), 12 (kitti) or 14 (tumv: ... vx vy vz wx wy wz). Use ReadOptions::format csv ReadOptions::columns ..."},
     {"header_only_csv.csv", "auto", ":2:1",
      "cannot detect the format: 4 comma-separated fields after a header row; EuRoC needs a '#timestamp' or '#time' header, VINS "
-     "integer nanosecond stamps and 8 or 11 fields. Use --format csv --columns ... (e.g. t_ns,px,py,pz,qw,qx,qy,qz)"},
+     "integer nanosecond stamps and 8 or 11 fields. Use ReadOptions::format csv ReadOptions::columns ... (e.g. t_ns,px,py,pz,qw,qx,qy,qz)"},
     {"wrong_field_count.txt", "kitti", ":1:18", "expected 12 fields (r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz), got 8"},
     // 1e400 is a finite decimal but no double: say so rather than only "expected a finite number".
     {"number_overflow.txt", "auto", ":2:5",
@@ -67,11 +68,11 @@ const BadFile kBadFiles[] = {
     // A header row that names another layout (w first) is not taken for TUM's order.
     {"tum_header_w_first.txt", "auto", ":1:9",
      "cannot detect the format: 8 space-separated fields after a header row that does not name tum's columns (t x "
-     "y z qx qy qz qw: a time first, then names ending in x y z x y z w); its field 5 is 'qw'. Use --format tum if "
-     "the columns are in that order, else --format csv --columns ..."},
+     "y z qx qy qz qw: a time first, then names ending in x y z x y z w); its field 5 is 'qw'. Use ReadOptions::format tum if "
+     "the columns are in that order, else ReadOptions::format csv ReadOptions::columns ..."},
     {"kitti_header.txt", "auto", ":2:1",
      "cannot detect the format: 12 space-separated fields after a header row; KITTI files have no header. Use "
-     "--format kitti if this is one, else --format csv --columns ..."},
+     "ReadOptions::format kitti if this is one, else ReadOptions::format csv ReadOptions::columns ..."},
 };
 
 class BadInputTest : public ::testing::TestWithParam<BadFile> {};

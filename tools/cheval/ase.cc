@@ -10,7 +10,7 @@ void RegisterAse(CLI::App& app, Action* action) {
       "Absolute state error on SE_2(3): rotation, position and velocity in one number (C-ASE)",
       [](CLI::App* command, EvalFlags* flags) {
         AddStateVelocityFlags(command, flags);
-        command->add_flag("--pose-only", flags->pose_only,
+        command->add_flag(Flag("EvaluationOptions::pose_only"), flags->options.pose_only,
                           "Pose-only ASE (rotation + position) for estimates without velocity");
       });
 }

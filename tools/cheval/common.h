@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cheval/traj/io.h"
+#include "option_names.h"
 
 namespace cheval::cli {
 
@@ -19,8 +20,8 @@ struct InputFlags {
   std::string columns;
   std::string kitti_times;
 
-  /// Validates the combination and converts to library options (UsageError on a bad combination).
-  traj::ReadOptions ToReadOptions() const;
+  /// The library's options (traj::ReadOptions::FromNames, which validates the combination).
+  traj::ReadOptions ToReadOptions() const { return traj::ReadOptions::FromNames(format, columns, kitti_times); }
 };
 
 /// Adds the input flags to `command`; `prefix` allows e.g. --ref-format (empty for --format).

@@ -22,41 +22,26 @@ using Evaluated = eval::EvaluationReport;
 traj::ReadOptions SideOptions(CLI::App* command, const EvalFlags& flags, const std::string& prefix,
                               const InputFlags& side) {
   InputFlags merged = flags.both;
-  auto given = [&](const std::string& name) { return command->get_option("--" + prefix + name)->count() > 0; };
-  if (given("format")) merged.format = side.format;
-  if (given("columns")) merged.columns = side.columns;
-  if (given("kitti-times")) merged.kitti_times = side.kitti_times;
+  auto given = [&](const char* field) { return command->get_option(Flag(field, prefix))->count() > 0; };
+  if (given("ReadOptions::format")) merged.format = side.format;
+  if (given("ReadOptions::columns")) merged.columns = side.columns;
+  if (given("ReadOptions::kitti_times_path")) merged.kitti_times = side.kitti_times;
   return merged.ToReadOptions();
-}
-
-// --delta-unit: the full name, or evo's letter f, m, d, r.
-eval::DeltaUnit ParseDeltaUnit(const std::string& name) {
-  if (name == "f") return eval::DeltaUnit::kFrames;
-  if (name == "m") return eval::DeltaUnit::kMeters;
-  if (name == "d") return eval::DeltaUnit::kDegrees;
-  if (name == "r") return eval::DeltaUnit::kRadians;
-  return *eval::DeltaUnitFromString(name);
 }
 
 }  // namespace
 
 eval::EvaluationOptions ToEvaluationOptions(eval::MetricKind metric, const EvalFlags& flags) {
-  eval::EvaluationOptions options;
+  eval::EvaluationOptions options = flags.options;
   options.metric = metric;
-  options.association.max_diff_ns = eval::SecondsToNanoseconds(flags.t_max_diff, "--t-max-diff");
-  options.association.offset_ns = eval::SecondsToNanoseconds(flags.t_offset, "--t-offset");
+  options.association = eval::AssociationOptions::FromSeconds(flags.t_max_diff, flags.t_offset);
   options.continuous_reference = flags.association == "continuous";
   options.alignment.method = *eval::AlignmentMethodFromString(flags.align);
-  options.alignment.n_align = flags.n_align;
   options.relation = *eval::PoseRelationFromString(flags.relation);
-  options.rpe.delta = flags.delta;
-  options.rpe.delta_unit = ParseDeltaUnit(flags.delta_unit);
-  options.rpe.all_pairs = flags.all_pairs;
-  options.kitti_drift = flags.kitti_drift;
+  options.rpe.delta_unit = *eval::DeltaUnitFromString(flags.delta_unit);
   options.reference_velocity = *eval::ReferenceVelocitySourceFromString(flags.gt_velocity);
   options.estimate_velocity_body_frame = flags.velocity_frame == "body";
-  options.pose_only = flags.pose_only;
-  eval::ValidateEvaluationOptions(options);
+  options.Validate();
   options.velocity.curve.progress = Progress().Fn();  // the reference fit of C-ASE, on a terminal only
   return options;
 }
@@ -83,7 +68,7 @@ std::vector<std::pair<std::string, double>> SortedStats(const eval::ErrorStatist
           {"rmse", s.rmse}, {"sse", s.sse},  {"std", s.std}};
 }
 
-void PrintResult(const EvalFlags& flags, const Evaluated& e, Eigen::Index ref_poses) {
+void PrintResult(const Evaluated& e, Eigen::Index ref_poses) {
   const eval::EvaluationResult& r = e.result;
   const Eigen::Index shorter = std::min(ref_poses, e.estimate_poses);
   if (r.association.by_index) {
@@ -93,7 +78,8 @@ void PrintResult(const EvalFlags& flags, const Evaluated& e, Eigen::Index ref_po
                e.estimate_path, r.association.size(), e.estimate_poses);
   } else {
     fmt::print("{}: found {} of max. {} possible matching timestamps (t_max_diff {} s, t_offset {} s)\n",
-               e.estimate_path, r.association.size(), shorter, flags.t_max_diff, flags.t_offset);
+               e.estimate_path, r.association.size(), shorter, e.options.association.max_diff_s(),
+               e.options.association.offset_s());
   }
   fmt::print("{}\n\n", r.title);
   if (!r.ase) {
@@ -135,39 +121,6 @@ void PrintComparison(const std::vector<Evaluated>& all) {
   }
 }
 
-// Per-pair CSV: stamp (and the pair's second stamp for RPE), error, ASE parts; with several
-// estimates the first column names the estimate.
-std::string ErrorsCsv(const std::vector<Evaluated>& all, eval::MetricKind metric) {
-  const bool several = all.size() > 1;
-  const eval::EvaluationResult& first = all.front().result;
-  std::string header = several ? "estimate," : "";
-  header += metric == eval::MetricKind::kRpe ? "stamp,stamp_end,error" : "stamp,error";
-  if (first.ase) {
-    if (first.ase->has_rotation) header += ",rotation";
-    header += ",position";
-    if (first.ase->has_velocity) header += ",velocity";
-  }
-  fmt::memory_buffer out;
-  auto it = std::back_inserter(out);
-  fmt::format_to(it, "{}\n", header);
-  for (const Evaluated& e : all) {
-    const eval::EvaluationResult& r = e.result;
-    for (size_t k = 0; k < r.errors.size(); ++k) {
-      if (several) fmt::format_to(it, "{},", e.estimate_path);
-      fmt::format_to(it, "{}", traj::FormatSeconds(r.stamps_ns[k]));
-      if (metric == eval::MetricKind::kRpe) fmt::format_to(it, ",{}", traj::FormatSeconds(r.stamps_end_ns[k]));
-      fmt::format_to(it, ",{}", r.errors[k]);
-      if (r.ase) {
-        if (r.ase->has_rotation) fmt::format_to(it, ",{}", r.ase->rotation[k]);
-        fmt::format_to(it, ",{}", r.ase->position[k]);
-        if (r.ase->has_velocity) fmt::format_to(it, ",{}", r.ase->velocity[k]);
-      }
-      fmt::format_to(it, "\n");
-    }
-  }
-  return fmt::to_string(out);
-}
-
 void Run(CLI::App* command, eval::MetricKind metric, const EvalFlags& flags) {
   const eval::EvaluationOptions options = ToEvaluationOptions(metric, flags);
   const EvalInputs inputs = ReadEvalInputs(command, flags);
@@ -182,17 +135,15 @@ void Run(CLI::App* command, eval::MetricKind metric, const EvalFlags& flags) {
     e.reference_poses = ref.size();
     e.estimate_path = flags.estimates[k];
     e.estimate_poses = ests[k].size();
-    e.max_diff_s = flags.t_max_diff;
-    e.offset_s = flags.t_offset;
     e.options = options;
     e.result = eval::Evaluate(ref.View(), ests[k].View(), options);
     all.push_back(std::move(e));
   }
   std::string json_text, errors_text;
   if (!flags.json_path.empty()) json_text = eval::EvaluationJson(all);
-  if (!flags.errors_path.empty()) errors_text = ErrorsCsv(all, metric);
+  if (!flags.errors_path.empty()) errors_text = eval::EvaluationErrorsCsv(all);
 
-  for (const Evaluated& e : all) PrintResult(flags, e, ref.size());
+  for (const Evaluated& e : all) PrintResult(e, ref.size());
   if (all.size() > 1) PrintComparison(all);
   std::vector<traj::FileToWrite> files;
   if (!flags.json_path.empty()) files.push_back({flags.json_path, json_text});
@@ -203,7 +154,7 @@ void Run(CLI::App* command, eval::MetricKind metric, const EvalFlags& flags) {
 }  // namespace
 
 void AddRelationFlag(CLI::App* command, EvalFlags* flags) {
-  command->add_option("-r,--relation", flags->relation, "Pose relation (evo's -r names)")
+  command->add_option("-r," + Flag("EvaluationOptions::relation"), flags->relation, "Pose relation (evo's -r names)")
       ->check(CLI::IsMember({"trans_part", "rot_part", "full", "angle_deg", "angle_rad", "point_distance"}))
       ->capture_default_str();
 }
@@ -214,15 +165,15 @@ void AddEvalInputFlags(CLI::App* command, EvalFlags* flags) {
   AddInputFlags(command, &flags->both);
   AddInputFlags(command, &flags->ref, "ref-");
   AddInputFlags(command, &flags->est, "est-");
-  command->add_option("--align", flags->align, "Alignment of each estimate onto the reference")
+  command->add_option(Flag("AlignmentOptions::method"), flags->align, "Alignment of each estimate onto the reference")
       ->check(CLI::IsMember({"none", "origin", "se3", "sim3", "scale", "posyaw", "full"}))
       ->capture_default_str();
-  command->add_option("--n-align", flags->n_align, "Solve the alignment from the first N pairs only (default: all)");
-  command->add_option("--t-max-diff", flags->t_max_diff, "Largest stamp difference of an associated pair, seconds")
+  command->add_option(Flag("AlignmentOptions::n_align"), flags->options.alignment.n_align, "Solve the alignment from the first N pairs only (default: all)");
+  command->add_option(Flag("AssociationOptions::max_diff_ns"), flags->t_max_diff, "Largest stamp difference of an associated pair, seconds")
       ->capture_default_str();
-  command->add_option("--t-offset", flags->t_offset, "Added to the estimate stamps: est + offset = ref, seconds")
+  command->add_option(Flag("AssociationOptions::offset_ns"), flags->t_offset, "Added to the estimate stamps: est + offset = ref, seconds")
       ->capture_default_str();
-  command->add_option("--association", flags->association,
+  command->add_option(Flag("EvaluationOptions::continuous_reference"), flags->association,
                       "nearest: each estimate pose with the nearest reference pose (evo); continuous: the reference's "
                       "Chebyshev curve evaluated at the exact estimate stamps")
       ->check(CLI::IsMember({"nearest", "continuous"}))
@@ -230,12 +181,12 @@ void AddEvalInputFlags(CLI::App* command, EvalFlags* flags) {
 }
 
 void AddStateVelocityFlags(CLI::App* command, EvalFlags* flags) {
-  command->add_option("--gt-velocity", flags->gt_velocity,
+  command->add_option(Flag("EvaluationOptions::reference_velocity"), flags->gt_velocity,
                       "Reference velocity: given (its columns), chebyshev or central (from its positions); "
                       "auto = given if present, else chebyshev")
       ->check(CLI::IsMember({"auto", "given", "chebyshev", "central"}))
       ->capture_default_str();
-  command->add_option("--velocity-frame", flags->velocity_frame,
+  command->add_option(Flag("EvaluationOptions::estimate_velocity_body_frame"), flags->velocity_frame,
                       "Frame of the estimate's velocity columns; body is rotated by the estimate's orientation")
       ->check(CLI::IsMember({"world", "body"}))
       ->capture_default_str();

@@ -1,8 +1,8 @@
 #pragma once
 // What `cheval ape`, `cheval rpe` and `cheval ase` share: the reference/estimate arguments, the input,
-// association, alignment and output flags, and the action (read, eval::Evaluate each estimate, print
-// evo's table, a comparison table for several estimates, --json, --errors). Each command's own file
-// adds its metric's flags.
+// association, alignment and output flags bound to eval::EvaluationOptions, and the action (read,
+// eval::Evaluate each estimate, print evo's table, a comparison table for several estimates, the
+// JSON and the per-pair CSV of the library). Each command's own file adds its metric's flags.
 
 #include <functional>
 #include <memory>
@@ -15,23 +15,22 @@
 namespace cheval::cli {
 
 /// Flags of the evaluation commands (the metric-specific ones are set by ape.cc, rpe.cc, ase.cc).
+/// Numbers and switches are bound to `options` directly; the flags whose text names an enum value,
+/// or which are in other units than the field (seconds for nanoseconds), are kept as given and
+/// converted by ToEvaluationOptions. Every default is the library's.
 struct EvalFlags {
   std::string reference;
   std::vector<std::string> estimates;
   InputFlags both, ref, est;
-  std::string align = "none";
-  int64_t n_align = 0;
-  double t_max_diff = 0.01;
-  double t_offset = 0.0;
-  std::string association = "nearest";
-  std::string relation = "trans_part";
-  double delta = 1.0;
-  std::string delta_unit = "frames";
-  bool all_pairs = false;
-  bool kitti_drift = false;
-  std::string gt_velocity = "auto";
-  std::string velocity_frame = "world";
-  bool pose_only = false;
+  eval::EvaluationOptions options;
+  std::string align{eval::ToString(options.alignment.method)};
+  double t_max_diff = options.association.max_diff_s();
+  double t_offset = options.association.offset_s();
+  std::string association = options.continuous_reference ? "continuous" : "nearest";
+  std::string relation{eval::ToString(options.relation)};
+  std::string delta_unit{eval::ToString(options.rpe.delta_unit)};
+  std::string gt_velocity{eval::ToString(options.reference_velocity)};
+  std::string velocity_frame = options.estimate_velocity_body_frame ? "body" : "world";
   std::string json_path;
   std::string errors_path;
 };
@@ -47,7 +46,7 @@ void AddEvalInputFlags(CLI::App* command, EvalFlags* flags);
 /// Adds the ASE's velocity flags --gt-velocity and --velocity-frame.
 void AddStateVelocityFlags(CLI::App* command, EvalFlags* flags);
 
-/// The library options of an evaluation of `metric` from the flags; UsageError on a bad combination.
+/// The library options of an evaluation of `metric` from the flags, validated (OptionError).
 eval::EvaluationOptions ToEvaluationOptions(eval::MetricKind metric, const EvalFlags& flags);
 
 /// The files of an evaluation, read.

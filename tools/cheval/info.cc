@@ -1,8 +1,9 @@
 // `cheval info FILE...`: what is in a trajectory file, like `evo_traj --full_check`.
 #include <cstdio>
 
+#include <vector>
+
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include "cheval/traj/stamp.h"
 #include "cheval/traj/summary.h"
@@ -16,37 +17,6 @@ struct InfoFlags {
   InputFlags input;
   std::string json_path;
 };
-
-nlohmann::json StatsJson(const traj::BasicStats& s) {
-  return {{"mean", s.mean}, {"median", s.median}, {"min", s.min}, {"max", s.max}, {"std", s.std}, {"n", s.n}};
-}
-
-nlohmann::json SummaryJson(const std::string& path, traj::Format format, const traj::TrajectorySummary& s) {
-  nlohmann::json j;
-  j["path"] = path;
-  j["format"] = std::string(traj::ToString(format));
-  j["poses"] = s.poses;
-  j["has_stamps"] = s.has_stamps;
-  j["first_stamp_s"] = traj::FormatSeconds(s.first_stamp_ns);
-  j["last_stamp_s"] = traj::FormatSeconds(s.last_stamp_ns);
-  j["duration_s"] = s.duration_s;
-  j["rate_hz"] = s.rate_hz;
-  j["dt_s"] = StatsJson(s.dt_s);
-  j["gaps"] = s.gaps;
-  j["largest_gap_s"] = s.largest_gap_s;
-  j["path_length_m"] = s.path_length_m;
-  j["speed_mps"] = StatsJson(s.speed_mps);
-  j["speed_source"] = s.speed_from_velocity ? "velocity" : "finite_differences";
-  j["has_orientation"] = s.has_orientation;
-  j["has_velocity"] = s.has_velocity;
-  j["has_angular_velocity"] = s.has_angular_velocity;
-  j["duplicate_stamps"] = s.duplicate_stamps;
-  j["non_increasing_stamps"] = s.non_increasing_stamps;
-  j["non_unit_quaternions"] = s.non_unit_quaternions;
-  j["max_quaternion_norm_error"] = s.max_quaternion_norm_error;
-  j["max_orthonormality_error"] = s.max_orthonormality_error;
-  return j;
-}
 
 void PrintSummary(const std::string& path, traj::Format format, const traj::TrajectorySummary& s) {
   auto line = [](std::string_view key, const std::string& value) { fmt::print("  {:<22}{}\n", key, value); };
@@ -99,17 +69,14 @@ void RegisterInfo(CLI::App& app, Action* action) {
   command->callback([flags, action] {
     *action = [flags] {
       const traj::ReadOptions options = flags->input.ToReadOptions();
-      nlohmann::json all = nlohmann::json::array();
+      std::vector<traj::FileSummary> all;
       for (const std::string& path : flags->paths) {
-        traj::Format format = options.format;
-        const traj::Trajectory trajectory = traj::ReadTrajectory(path, options, &format);
-        const traj::TrajectorySummary summary = traj::Summarize(trajectory.View());
-        PrintSummary(path, format, summary);
-        all.push_back(SummaryJson(path, format, summary));
+        traj::FileSummary& file = all.emplace_back(traj::FileSummary{path, options.format, {}});
+        const traj::Trajectory trajectory = traj::ReadTrajectory(path, options, &file.format);
+        file.summary = traj::Summarize(trajectory.View());
+        PrintSummary(path, file.format, file.summary);
       }
-      if (!flags->json_path.empty()) {
-        traj::WriteFileAtomically(flags->json_path, (all.size() == 1 ? all[0] : all).dump(2) + "\n");
-      }
+      if (!flags->json_path.empty()) traj::WriteFileAtomically(flags->json_path, traj::SummaryJson(all));
     };
   });
 }

@@ -1,14 +1,15 @@
 // cheval: one executable, one subcommand per file. main() parses, runs the chosen action and maps
-// the library's typed errors to the documented exit codes (docs/cli.md).
+// the library's typed errors to the documented exit codes (docs/cli.md), each message with the
+// library's option fields spelled as flags (option_names.h).
 #include <cstdio>
 #include <exception>
-#include <map>
 #include <string>
 
 #include <fmt/format.h>
 
 #include "cheval/common/error.h"
 #include "common.h"
+#include "option_names.h"
 #include "progress.h"
 
 int main(int argc, char** argv) {
@@ -37,7 +38,7 @@ int main(int argc, char** argv) {
   cheval::cli::RegisterEstimateThrust(app, &action);
 
   auto fail = [](ExitCode code, const std::string& message) {
-    std::fprintf(stderr, "%s\n", message.c_str());
+    std::fprintf(stderr, "%s\n", cheval::cli::Spell(message).c_str());
     return static_cast<int>(code);
   };
   try {
@@ -57,14 +58,6 @@ int main(int argc, char** argv) {
     return static_cast<int>(ExitCode::kOk);
   } catch (const cheval::InputError& e) {
     return fail(ExitCode::kInput, e.what());
-  } catch (const cheval::OptionError& e) {
-    // The library names the options field; the flag that sets it (fields without a flag keep the
-    // library's spelling).
-    static const std::map<std::string, std::string> kFlags{
-        {"window_s", "--window"}, {"fixed_degree", "--degree"}, {"tolerance", "--tolerance"}, {"rate_hz", "--rate"}};
-    const auto flag = kFlags.find(e.field());
-    return fail(ExitCode::kUsage,
-                fmt::format("cheval: error: {}", flag == kFlags.end() ? std::string(e.what()) : e.Message(flag->second)));
   } catch (const cheval::UsageError& e) {
     return fail(ExitCode::kUsage, fmt::format("cheval: error: {}", e.what()));
   } catch (const cheval::ComputeError& e) {

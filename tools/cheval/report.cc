@@ -12,19 +12,18 @@ namespace {
 struct ReportFlags {
   EvalFlags eval;
   std::string output;
-  std::size_t max_points = 5000;
+  report::ReportOptions options;  // max_points bound; the rest set by Run
 };
 
 void Run(CLI::App* command, const ReportFlags& flags) {
   // Before any work: a build without the page cannot write one.
   report::RequireReportPage();
-  report::ReportOptions options;
+  report::ReportOptions options = flags.options;
   options.ape = ToEvaluationOptions(eval::MetricKind::kApe, flags.eval);
   options.ase = ToEvaluationOptions(eval::MetricKind::kAse, flags.eval);
-  options.max_diff_s = flags.eval.t_max_diff;
-  options.offset_s = flags.eval.t_offset;
-  options.max_points = flags.max_points;
   options.generator = fmt::format("cheval {}", CHEVAL_VERSION);
+  options.option_names = FlagNames();  // the notes quote library messages
+  options.Validate();
   const EvalInputs inputs = ReadEvalInputs(command, flags.eval);
   std::vector<report::ReportInput> estimates;
   for (size_t k = 0; k < inputs.estimates.size(); ++k) {
@@ -65,7 +64,7 @@ void RegisterReport(CLI::App& app, Action* action) {
   AddStateVelocityFlags(command, &flags->eval);
   command->add_option("-o,--output", flags->output, "The HTML file to write")->required();
   command
-      ->add_option("--max-points", flags->max_points,
+      ->add_option(Flag("ReportOptions::max_points"), flags->options.max_points,
                    "Most points of one plotted series (min/max buckets over time; the statistics use every pair)")
       ->capture_default_str();
   command->callback([command, flags, action] { *action = [command, flags] { Run(command, *flags); }; });

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// Alignment of an estimate onto a reference (METRICS.md §3): a similarity S found from the
+/// Alignment of an estimate onto a reference (docs/evaluation.md, "Alignment"): a similarity S found from the
 /// associated pairs and applied to every estimate state — orientation, position and velocity:
 /// R' = R·R_i, p' = c·R·p_i + t, v' = c·R·v_i.
 ///
@@ -8,9 +8,9 @@
 /// |----------|------------------------------------------------------------------------------|-----|
 /// | none     | nothing (evo's default)                                                      | 0   |
 /// | origin   | T = T_ref,0 · T_est,0⁻¹ (first pair; needs both orientations)                 | 6   |
-/// | se3      | Umeyama (1991) without scale: min Σ|y_i - R x_i - t|² (evo `--align`)        | 6   |
-/// | sim3     | Umeyama with scale: min Σ|y_i - c R x_i - t|² (evo `--align --correct_scale`) | 7   |
-/// | scale    | the Sim(3) Umeyama scale c alone: p' = c·p (evo `--correct_scale`)            | 1   |
+/// | se3      | Umeyama (1991) without scale: min Σ|y_i - R x_i - t|² (evo's align)          | 6   |
+/// | sim3     | Umeyama with scale: min Σ|y_i - c R x_i - t|² (evo's align + correct_scale) | 7   |
+/// | scale    | the Sim(3) Umeyama scale c alone: p' = c·p (evo's correct_scale)              | 1   |
 /// | posyaw   | rotation restricted to yaw about the reference z (gravity) axis, then t      | 4   |
 /// | full     | SE(3) minimising the ASE itself: Σ ‖R_q,iᵀ R R_p,i − I‖² + |R p_i + t − q_i|² + |R v_i − u_i|² | 6 |
 ///
@@ -56,6 +56,9 @@ struct AlignmentOptions {
   AlignmentMethod method = AlignmentMethod::kNone;
   /// Solve from the first n_align pairs only (all when 0 or more than there are); apply to all.
   Eigen::Index n_align = 0;
+
+  /// Throws OptionError for a negative n_align, or n_align > 0 with method kNone.
+  void Validate() const;
 };
 
 /// The alignment and how it was obtained.
@@ -73,7 +76,8 @@ struct AlignmentResult {
 /// Solves the alignment of the estimate of `pairs` (raw estimate states; the alignment already set
 /// on `pairs` is ignored) onto its reference. kFull uses every channel both sides have: rotation,
 /// position, velocity (set the reference velocities / the body-frame flag on `pairs` first).
-/// Throws ComputeError on degenerate input (fewer than 3 pairs, collinear positions, origin or full
+/// Throws OptionError for bad options (Validate(); not checked for method kNone) and ComputeError on
+/// degenerate input (fewer than 3 pairs, collinear positions, origin or full
 /// without orientation where needed) with a message saying what is missing.
 AlignmentResult ComputeAlignment(const PairedStates& pairs, const AlignmentOptions& options);
 

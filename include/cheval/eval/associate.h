@@ -2,7 +2,7 @@
 /// \file
 /// Time association of a reference and an estimate: which reference pose each estimate pose is
 /// compared with. The semantics are evo's (`evo.core.sync.associate_trajectories`, v1.36.5;
-/// METRICS.md §2), computed in O((n + m) log m) instead of evo's O(n·m) brute force:
+/// docs/evaluation.md, "Association"), computed in O((n + m) log m) instead of evo's O(n·m) brute force:
 ///
 /// - iterate over the **shorter** list (the estimate when both have the same length) in file order;
 /// - for each of its stamps s take the **nearest** stamp of the other list (reference stamps minus the
@@ -25,12 +25,22 @@
 
 namespace cheval::eval {
 
-/// Options of the association; the defaults are evo's (`--t_max_diff 0.01`, `--t_offset 0`).
+/// Options of the association; the defaults are evo's (t_max_diff 0.01 s, t_offset 0).
 struct AssociationOptions {
   /// Largest accepted |t_ref - (t_est + offset)|, nanoseconds (inclusive). Must be >= 0.
   int64_t max_diff_ns = 10'000'000;
-  /// Added to every estimate stamp: est_time + offset ≈ ref_time (evo's `--t_offset`), nanoseconds.
+  /// Added to every estimate stamp: est_time + offset ≈ ref_time (evo's t_offset), nanoseconds.
   int64_t offset_ns = 0;
+
+  /// The options from seconds as a user gives them, each rounded to the nearest nanosecond. Throws
+  /// OptionError naming max_diff_ns or offset_ns when a value is not finite or does not fit in int64.
+  static AssociationOptions FromSeconds(double max_diff_s, double offset_s);
+  /// The fields in seconds (exactly the seconds given to FromSeconds when they have at most nine
+  /// decimals: ns / 1e9 is the double nearest to that decimal).
+  double max_diff_s() const { return static_cast<double>(max_diff_ns) / 1e9; }
+  double offset_s() const { return static_cast<double>(offset_ns) / 1e9; }
+  /// Throws OptionError for a negative max_diff_ns.
+  void Validate() const;
 };
 
 /// Pairs of associated poses: pair k compares reference pose `ref[k]` with estimate pose `est[k]`.
@@ -46,23 +56,24 @@ struct Association {
 };
 
 /// Associates two lists of stamps with evo's rule (see the file comment). Any order, duplicates
-/// allowed. Returns the pairs in the order of the shorter list (possibly none). Throws UsageError
-/// for a negative max_diff.
+/// allowed. Returns the pairs in the order of the shorter list (possibly none). Throws OptionError
+/// for a negative max_diff (options.Validate()).
 Association AssociateStamps(std::span<const int64_t> ref_stamps_ns, std::span<const int64_t> est_stamps_ns,
                             const AssociationOptions& options = {});
 
 /// Associates two trajectories. When either has no stamps (KITTI without a times file), pose i is
 /// paired with pose i, as evo's `kitti` mode does, and the lengths must agree. Throws ComputeError
 /// when the lengths differ in that case, and when no pair is found: the message gives both stamp
-/// ranges and suggests --t-offset or checking the stamp units.
+/// ranges and suggests an offset or checking the stamp units.
 Association Associate(const traj::TrajectoryView& ref, const traj::TrajectoryView& est,
                       const AssociationOptions& options = {});
 
 /// The stamps of the poses of `association` on one side, in pair order.
 std::vector<int64_t> PairedStamps(std::span<const int64_t> stamps_ns, std::span<const Eigen::Index> indices);
 
-/// Converts seconds (as given on a command line) to nanoseconds, rounding to the nearest; throws
-/// UsageError naming `what` if the value is not finite or does not fit in int64.
+/// Converts seconds (as a user gives them) to nanoseconds, rounding to the nearest; throws UsageError
+/// naming `what` (an option as `STRUCT::FIELD`, common/option_names.h) if the value is not finite or
+/// does not fit in int64.
 int64_t SecondsToNanoseconds(double seconds, const std::string& what);
 
 }  // namespace cheval::eval

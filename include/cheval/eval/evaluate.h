@@ -2,7 +2,8 @@
 /// \file
 /// One evaluation end to end, the data flow of DESIGN.md: two trajectories -> association (index
 /// pairs) -> reference velocity if the metric needs it -> alignment (a similarity applied to R, p, v)
-/// -> per-pair errors -> statistics. The CLI's `ape`, `rpe` and `ase` are this call plus printing.
+/// -> per-pair errors -> statistics. The CLI's `ape`, `rpe` and `ase` are this call plus printing
+/// (docs/evaluation.md).
 
 #include <cstdint>
 #include <optional>
@@ -58,6 +59,12 @@ struct EvaluationOptions {
   bool estimate_velocity_body_frame = false;
   /// ASE without velocity (rotation + position only) instead of an error when velocity is missing.
   bool pose_only = false;
+
+  /// Checks the fields and combinations a caller can get wrong, before any work (Evaluate calls it):
+  /// association, alignment, RPE (metric kRpe) and velocity options, pose_only together with a
+  /// body-frame estimate velocity, continuous_reference with a reference velocity other than auto
+  /// or chebyshev. Throws OptionError naming the first bad field.
+  void Validate() const;
 };
 
 /// The result of Evaluate: what was paired, how it was aligned, the errors and their statistics.
@@ -92,15 +99,9 @@ struct EvaluationResult {
   std::optional<DriftResult> drift;
 };
 
-/// Checks the option combinations a caller can get wrong, before any work, and throws UsageError
-/// naming the CLI option and the rule: a negative association max_diff ("--t-max-diff"), a negative
-/// n_align, n_align without an alignment method, pose_only together with a body-frame estimate
-/// velocity.
-void ValidateEvaluationOptions(const EvaluationOptions& options);
-
-/// Evaluates `est` against `ref`. Throws UsageError for bad options and ComputeError when the
-/// evaluation is impossible (no pairs, degenerate alignment, missing orientation or velocity), with a
-/// message saying what to change.
+/// Evaluates `est` against `ref`. Throws OptionError for bad options (options.Validate()) and
+/// ComputeError when the evaluation is impossible (no pairs, degenerate alignment, missing
+/// orientation or velocity), with a message saying what to change.
 EvaluationResult Evaluate(const traj::TrajectoryView& ref, const traj::TrajectoryView& est,
                           const EvaluationOptions& options);
 
@@ -111,20 +112,24 @@ struct EvaluationReport {
   Eigen::Index reference_poses = 0;
   std::string estimate_path;
   Eigen::Index estimate_poses = 0;
-  /// The association's largest stamp difference and offset in seconds as the caller gave them
-  /// (EvaluationOptions holds them rounded to nanoseconds; the JSON repeats what was asked).
-  double max_diff_s = 0.01;
-  double offset_s = 0.0;
   EvaluationOptions options;
   EvaluationResult result;
 };
 
-/// The JSON of evaluations with the keys of METRICS.md §9 (docs/evaluation.md, "Output"): per report
+/// The JSON of evaluations (docs/evaluation.md, "Output"): per report
 /// `command`, `reference`, `estimate`, `association`, `alignment`, `metric`, `stats`, and for RPE
 /// `metric.delta`, `metric.delta_unit`, `metric.all_pairs` (+ `drift`), for ASE `parts` and
-/// `velocity_source`. One object for one report, an array for several; 2-space indentation and a
-/// final newline; doubles in the shortest form that reads back to the same double. What `cheval
-/// ape|rpe|ase --json` writes and the Python module returns (as a dict).
+/// `velocity_source`; `association.max_diff` and `offset` in seconds (AssociationOptions::max_diff_s()).
+/// One object for one report, an array for several; 2-space indentation and a final newline;
+/// doubles in the shortest form that reads back to the same double. What the CLI's `ape`, `rpe`
+/// and `ase` write with their JSON option and the Python module returns (as a dict).
 std::string EvaluationJson(std::span<const EvaluationReport> reports);
+
+/// The per-pair errors of evaluations as CSV (docs/evaluation.md, "Output"): a header row, then per
+/// error the estimate stamp (s), for RPE the pair's second stamp (`stamp_end`), the error and for ASE
+/// its parts (rotation when both sides have orientation, position, velocity unless pose-only). With
+/// several reports a first column `estimate` names each report's estimate_path. Numbers in the
+/// shortest form that reads back to the same double; stamps exactly (traj::FormatSeconds).
+std::string EvaluationErrorsCsv(std::span<const EvaluationReport> reports);
 
 }  // namespace cheval::eval

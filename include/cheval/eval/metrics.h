@@ -1,8 +1,8 @@
 #pragma once
 /// \file
-/// Per-pair errors: APE and RPE exactly as evo v1.36.5 computes them (METRICS.md §4–§6), KITTI-style
+/// Per-pair errors: APE and RPE exactly as evo v1.36.5 computes them (docs/evaluation.md, "Metrics"), KITTI-style
 /// drift (the KITTI odometry devkit's segment errors), and the Absolute State Error on SE_2(3) of
-/// the C-ASE paper (METRICS.md §8).
+/// the C-ASE paper (docs/evaluation.md, "Metrics").
 ///
 /// Notation: Q = reference pose, P = aligned estimate pose, both T = [R t; 0 1] with inverses formed
 /// by transposition (never a general matrix inverse). KITTI rotations are used as read.
@@ -19,7 +19,7 @@
 
 namespace cheval::eval {
 
-/// What of a pose error is measured (evo's `--pose_relation` / `-r` names in the comments).
+/// What of a pose error is measured (evo's pose_relation names in the comments).
 enum class PoseRelation {
   kTranslation,    ///< "trans_part": |t(E)| (APE: |p_est − p_ref|), metres
   kRotation,       ///< "rot_part": ‖R(E) − I‖_F, unit-less
@@ -51,10 +51,11 @@ double RotationAngle(const Eigen::Matrix3d& R);
 /// relation needs orientations a trajectory does not have.
 std::vector<double> ApeErrors(const PairedStates& pairs, PoseRelation relation);
 
-/// Unit of the RPE pair distance δ (evo's `--delta_unit` f, m, d, r).
+/// Unit of the RPE pair distance δ (evo's delta_unit f, m, d, r).
 enum class DeltaUnit { kFrames, kMeters, kDegrees, kRadians };
 /// "frames", "meters", "degrees", "radians".
 std::string_view ToString(DeltaUnit unit);
+/// Parses a unit name or evo's letter for it (f, m, d, r); nullopt if unknown.
 std::optional<DeltaUnit> DeltaUnitFromString(std::string_view name);
 /// evo's unit label: "frames", "m", "deg", "rad".
 std::string_view DeltaUnitLabel(DeltaUnit unit);
@@ -68,6 +69,10 @@ struct RpeOptions {
   bool all_pairs = false;
   /// Relative tolerance on δ in all-pairs mode for meters/degrees/radians (evo's rel_delta_tol).
   double relative_delta_tolerance = 0.1;
+
+  /// Throws OptionError unless δ is positive and finite, an integer for frames and at most 180° (π
+  /// rad) for an angle.
+  void Validate() const;
 };
 
 /// A pair (i, j) of positions in the list of associated pairs.
@@ -76,7 +81,7 @@ struct IndexPair {
   bool operator==(const IndexPair&) const = default;
 };
 
-/// The RPE's index pairs, chosen on the aligned estimate as evo's `filters` do (METRICS.md §5):
+/// The RPE's index pairs, chosen on the aligned estimate as evo's `filters` do (docs/evaluation.md, "Metrics"):
 /// - frames, consecutive: ids 0, δ, 2δ, ... and the pairs of neighbouring ids; all pairs: (i, i + δ);
 /// - meters, consecutive: walk the path summing |p_i − p_prev|; when the sum reaches δ, i is an id
 ///   and the sum restarts (index 0 is not an id); pairs of neighbouring ids. All pairs: for each i the
@@ -116,7 +121,7 @@ struct DriftResult {
 /// (ComputeError otherwise).
 DriftResult KittiDrift(const PairedStates& pairs);
 
-/// The Absolute State Error of every pair (METRICS.md §8): E_i = Q_i⁻¹ · S(P_i) in SE_2(3) with
+/// The Absolute State Error of every pair (docs/evaluation.md, "Metrics"): E_i = Q_i⁻¹ · S(P_i) in SE_2(3) with
 /// composition (R1R2, R1p2 + p1, R1v2 + v1), ASE_i = ‖E_i − I₅‖_F, and its parts
 /// rotation ‖R_qᵀ R_p − I‖_F, position |R_qᵀ (p_p − p_q)|, velocity |R_qᵀ (v_p − v_q)|
 /// (ASE_i² is the sum of their squares). Channels one side lacks are left out and flagged:

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// Statistics of per-pair errors, exactly as evo reports them (METRICS.md §7, evo's
+/// Statistics of per-pair errors, exactly as evo reports them (docs/evaluation.md, "Statistics"; evo's
 /// `PE.get_all_statistics`): rmse = sqrt(mean(e²)), mean, median (mean of the two middle values
 /// for an even count, as numpy.median), std (population, ddof 0), min, max, sse = Σ e², n.
 

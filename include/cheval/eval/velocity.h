@@ -7,7 +7,9 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -35,10 +37,31 @@ struct VelocityOptions {
   /// kSavitzkyGolay: window length in samples (odd, >= 5); the polynomial is cubic. Uses the
   /// actual stamps (a local fit in time), so uneven sampling is handled.
   int savgol_window = 21;
+  /// kSavitzkyGolay: the window in seconds instead of savgol_window: the nearest odd number of
+  /// samples at the trajectory's mean rate, at least 5 (SavitzkyGolaySamples).
+  std::optional<double> savgol_window_s;
   /// Also body angular velocity from the orientations (kChebyshev: a RotationCurve fitted with the
   /// same curve options; kCentral: central differences on the group). Needs orientations.
   bool angular = false;
+
+  /// Throws OptionError for a Savitzky–Golay window that is not an odd number >= 5 of samples or not
+  /// a positive number of seconds, and for angular with kSavitzkyGolay.
+  void Validate() const;
 };
+
+/// Curve options from the names the faces take: `degree` "auto" (= "cv", cross-validation), "chop"
+/// or a non-negative integer (a fixed degree, fitted over each gap-free segment at once
+/// when no window is given); `window_s` the fixed window length (s), nullopt for adaptive windows.
+/// Throws OptionError naming CurveOptions::degree_method for any other degree.
+cheb::CurveOptions CurveOptionsFromNames(std::string_view degree, std::optional<double> window_s = std::nullopt);
+
+/// The name of the curve's degree choice as CurveOptionsFromNames takes it: "auto", "chop" or the
+/// fixed degree.
+std::string DegreeName(const cheb::CurveOptions& options);
+
+/// The Savitzky–Golay window of `window_s` seconds in samples at the mean rate of `stamps_ns`
+/// ((n - 1) / duration): the nearest odd number, at least 5.
+int SavitzkyGolaySamples(std::span<const int64_t> stamps_ns, double window_s);
 
 /// Velocities and what the Chebyshev fit chose.
 struct VelocityEstimate {
@@ -57,9 +80,38 @@ struct VelocityEstimate {
 
 /// Estimates world-frame velocity at `at_ns` (nullopt: at the trajectory's own stamps) from its
 /// positions. Central differences and Savitzky–Golay work only at the trajectory's own stamps
-/// (UsageError otherwise); they need stamps in increasing order (ComputeError otherwise).
-/// Throws ComputeError when the data cannot support the method (too few samples, equal stamps...).
+/// (OptionError naming VelocityOptions::method otherwise); they need stamps in increasing order
+/// (ComputeError otherwise). Throws OptionError for bad options (options.Validate()) and for
+/// angular on a trajectory without orientation, ComputeError for a trajectory without stamps and
+/// when the data cannot support the method (too few samples, equal stamps...).
 VelocityEstimate EstimateVelocity(const traj::TrajectoryView& trajectory, const VelocityOptions& options,
                                   std::optional<std::span<const int64_t>> at_ns = std::nullopt);
+
+/// The trajectory of an estimate (what `cheval velocity -o` writes, docs/velocity.md): at the
+/// trajectory's own stamps (`at_ns` nullopt) its positions and orientations as read; at other
+/// stamps the fitted positions and orientations (the fitted orientation curve with `angular`, else
+/// slerp between the neighbouring orientations of the input, whose stamps must be sorted); the
+/// identity where the input has no orientation. Velocities, and the angular velocities when the
+/// estimate has them.
+traj::Trajectory VelocityTrajectory(const traj::TrajectoryView& trajectory, const VelocityEstimate& estimate,
+                                    std::optional<std::span<const int64_t>> at_ns = std::nullopt);
+
+/// What VelocityJson reports besides the estimate: the input as the caller names it and the run.
+struct VelocityRun {
+  std::string input_path;
+  Eigen::Index input_poses = 0;
+  VelocityOptions options;
+  /// Number of stamps the velocity was evaluated at.
+  size_t evaluated_at = 0;
+  /// Wall-clock time of the run as the caller measured it.
+  double seconds = 0;
+};
+
+/// The JSON of `cheval velocity --json` (docs/velocity.md): command, input {path, poses}, method,
+/// evaluated_at; with a Chebyshev curve degree_method (DegreeName), segments, windows, degrees (per
+/// window and coordinate), window_list (begin_s, end_s, samples, degrees), noise_sigma_m,
+/// residual_rmse_m, compression_ratio (3 n / stored values); with a rotation curve angular {charts,
+/// residual_rms_rad}; seconds. 2-space indentation and a final newline.
+std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimate);
 
 }  // namespace cheval::eval

@@ -9,10 +9,12 @@
 
 #include <cstddef>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "cheval/common/option_names.h"
 #include "cheval/eval/evaluate.h"
 #include "cheval/traj/trajectory.h"
 
@@ -31,10 +33,6 @@ struct ReportOptions {
   /// The ASE's options (reference velocity source, estimate velocity frame, the same association and
   /// alignment); its metric is ignored.
   eval::EvaluationOptions ase;
-  /// The association's largest stamp difference and offset in seconds as the caller gave them (the
-  /// embedded results repeat them, as `cheval ape --json` does).
-  double max_diff_s = 0.01;
-  double offset_s = 0.0;
   /// Most points of one plotted series (min/max buckets for series over time, a stride for paths).
   std::size_t max_points = 5000;
   /// Most windows of the reference's Chebyshev fit whose coefficient magnitudes are embedded (evenly
@@ -42,6 +40,13 @@ struct ReportOptions {
   std::size_t max_fit_windows = 64;
   /// Shown in the page's footer, e.g. "cheval 0.1.0".
   std::string generator;
+  /// The caller's spelling of option names in the notes, which quote library messages
+  /// (common/option_names.h; empty: the library's STRUCT::FIELD names). Must outlive BuildReport.
+  std::span<const OptionName> option_names;
+
+  /// Validates ape and ase (EvaluationOptions::Validate) and throws OptionError for max_points < 16
+  /// or max_fit_windows < 1.
+  void Validate() const;
 };
 
 /// What BuildReport computed.
@@ -61,12 +66,12 @@ struct Report {
 
 /// Evaluates every estimate against the reference (APE; ASE where the estimate has velocity) and
 /// gathers the series the page plots. Throws what eval::Evaluate throws for the APE (the errors of
-/// `cheval ape`, e.g. ComputeError when no pair is found), UsageError for bad options (also the
-/// ASE's) and for max_points < 16 or max_fit_windows < 1. What can be computed for the charts alone
-/// becomes a note instead of an error: an estimate without velocity, an ASE that is impossible where
-/// the APE is not (ComputeError, e.g. a reference without stamps to derive its velocity from, or
-/// --gt-velocity given on a reference without velocity), a reference velocity or fit that cannot be
-/// computed (no stamps, too few samples).
+/// `cheval ape`, e.g. ComputeError when no pair is found) and OptionError for bad options
+/// (options.Validate()). What can be computed for the charts alone becomes a note instead of an
+/// error: an estimate without velocity, an ASE that is impossible where the APE is not (ComputeError,
+/// e.g. a reference without stamps to derive its velocity from, or a given reference velocity on a
+/// reference without velocity columns), a reference velocity or fit that cannot be computed (no
+/// stamps, too few samples).
 Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>& estimates,
                    const ReportOptions& options);
 

@@ -68,12 +68,20 @@ struct ReadOptions {
   std::optional<ColumnMap> columns;
   /// KITTI only: a file with one stamp (seconds) per pose. Without it, KITTI poses have no stamps.
   std::string kitti_times_path;
+
+  /// The options from the names the faces take: `format` a Format name ("auto", "tum", ...), `columns`
+  /// a column map spec (ColumnMap::Parse; implies csv; empty for none), `kitti_times_path` as the
+  /// field. Throws OptionError naming ReadOptions::format for an unknown format or csv without a
+  /// column map, ReadOptions::columns for a map with a format other than csv or auto,
+  /// ReadOptions::kitti_times_path for times with a format other than kitti or auto; UsageError from
+  /// ColumnMap::Parse.
+  static ReadOptions FromNames(std::string_view format, std::string_view columns, std::string kitti_times_path);
 };
 
 /// Decides the format of a file from its name and content (the text, not a path): `#timestamp`
 /// header with commas -> euroc; comma-separated integer nanosecond stamps with 8 or 11 values ->
 /// vins; whitespace-separated rows of 8 -> tum, 11 -> tumv, 12 -> kitti. Throws InputError
-/// explaining what was seen when no format fits (suggesting `--format csv --columns ...`).
+/// explaining what was seen when no format fits (suggesting format csv with a column map).
 Format DetectFormat(const std::string& path, std::string_view content);
 
 /// Reads a trajectory file. Throws InputError (`path:line:column: error: ...`) on any problem:

@@ -3,8 +3,10 @@
 /// What `cheval info` reports about a trajectory (a superset of `evo_traj --full_check`).
 
 #include <cstdint>
+#include <span>
 #include <string>
 
+#include "cheval/traj/io.h"
 #include "cheval/traj/trajectory.h"
 
 namespace cheval::traj {
@@ -61,5 +63,21 @@ TrajectorySummary Summarize(const TrajectoryView& trajectory);
 
 /// Statistics of `values` (copied and sorted for the median). Empty input gives zeros.
 BasicStats ComputeBasicStats(std::vector<double> values);
+
+/// One summarised file: its path as the caller names it, the format it was read as, its summary.
+struct FileSummary {
+  std::string path;
+  Format format = Format::kAuto;
+  TrajectorySummary summary;
+};
+
+/// The JSON of `cheval info --json` (docs/formats.md): per file path, format, poses, has_stamps,
+/// first_stamp_s and last_stamp_s (exact decimal strings), duration_s, rate_hz, dt_s {mean, median,
+/// min, max, std, n}, gaps, largest_gap_s, path_length_m, speed_mps {...}, speed_source ("velocity"
+/// or "finite_differences"), has_orientation, has_velocity, has_angular_velocity, duplicate_stamps,
+/// non_increasing_stamps, non_unit_quaternions, max_quaternion_norm_error,
+/// max_orthonormality_error. One object for one file, an array for several; keys sorted, 2-space
+/// indentation and a final newline.
+std::string SummaryJson(std::span<const FileSummary> files);
 
 }  // namespace cheval::traj

@@ -36,7 +36,7 @@ struct Channels {
   bool operator==(const Channels&) const = default;
 };
 
-/// Rotation matrix of the quaternion (x, y, z, w) exactly as evo computes it (METRICS.md §1): with
+/// Rotation matrix of the quaternion (x, y, z, w) exactly as evo computes it (docs/formats.md): with
 /// n = q·q, identity when n < 8.88e-16, else q scaled by sqrt(2/n) in the standard formula, so
 /// non-unit quaternions are normalised.
 Eigen::Matrix3d RotationFromQuaternion(double x, double y, double z, double w);

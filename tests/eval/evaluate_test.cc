@@ -1,0 +1,218 @@
+// eval::Evaluate end to end on hand-built trajectories, against the definitions of docs/evaluation.md:
+// APE of a rigidly moved copy (the offset before alignment, zero after), RPE invariant under a
+// global motion, the ASE's parts, the options' validation naming the field, the JSON and the
+// per-pair CSV.
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cheval/common/error.h"
+#include "cheval/eval/evaluate.h"
+#include "eval_test_util.h"
+#include "expect_option_error.h"
+
+namespace cheval::eval {
+namespace {
+
+using cheval::testing::ExpectOptionError;
+using testing::AxisAngle;
+using testing::MakeTrajectory;
+using testing::PoseSpec;
+
+constexpr int64_t kPeriodNs = 10'000'000;  // 100 Hz
+
+// A helix with changing orientation and its exact velocity, n poses at 100 Hz.
+std::vector<PoseSpec> Helix(int n) {
+  std::vector<PoseSpec> poses;
+  for (int i = 0; i < n; ++i) {
+    const double t = 0.01 * i;
+    PoseSpec s;
+    s.stamp_ns = 1'000'000'000 + i * kPeriodNs;
+    s.p = {std::cos(t), std::sin(t), 0.2 * t};
+    s.v = {-std::sin(t), std::cos(t), 0.2};
+    s.q = AxisAngle(t, Eigen::Vector3d::UnitZ()) * AxisAngle(0.3 * t, Eigen::Vector3d::UnitX());
+    poses.push_back(s);
+  }
+  return poses;
+}
+
+// Every pose moved by the rigid motion (R, t): p' = R p + t, q' = R q, v' = R v.
+std::vector<PoseSpec> Moved(std::vector<PoseSpec> poses, const Eigen::Quaterniond& R, const Eigen::Vector3d& t) {
+  for (PoseSpec& s : poses) {
+    s.p = R * s.p + t;
+    s.q = R * s.q;
+    s.v = R * s.v;
+  }
+  return poses;
+}
+
+TEST(EvaluateTest, ApeOfATranslatedCopyIsTheOffsetUnalignedAndZeroAligned) {
+  const traj::Trajectory ref = MakeTrajectory(Helix(300));
+  const traj::Trajectory est = MakeTrajectory(Moved(Helix(300), Eigen::Quaterniond::Identity(), {0.3, -0.4, 0}));
+  EvaluationOptions options;
+  const EvaluationResult raw = Evaluate(ref.View(), est.View(), options);
+  ASSERT_EQ(raw.errors.size(), 300u);
+  // APE trans_part = |p_est − p_ref| = |(0.3, −0.4, 0)| = 0.5 for every pair.
+  for (double e : raw.errors) EXPECT_NEAR(e, 0.5, 1e-12);
+  EXPECT_NEAR(raw.stats.rmse, 0.5, 1e-12);
+  EXPECT_EQ(raw.stats.n, 300);
+  EXPECT_EQ(raw.unit, "m");
+  EXPECT_EQ(raw.title, "APE w.r.t. translation part (m)\n(not aligned)");
+
+  options.alignment.method = AlignmentMethod::kSE3;
+  const EvaluationResult aligned = Evaluate(ref.View(), est.View(), options);
+  // Umeyama recovers the exact rigid motion: every error is zero up to rounding (|p| ~ 1).
+  EXPECT_LT(aligned.stats.max, 1e-12);
+  EXPECT_NEAR(aligned.alignment.transform.translation.x(), -0.3, 1e-12);
+  EXPECT_NEAR(aligned.alignment.transform.translation.y(), 0.4, 1e-12);
+  EXPECT_EQ(aligned.alignment.pairs_used, 300);
+}
+
+TEST(EvaluateTest, RpeIsInvariantUnderAGlobalRigidMotion) {
+  const traj::Trajectory ref = MakeTrajectory(Helix(200));
+  const traj::Trajectory est =
+      MakeTrajectory(Moved(Helix(200), AxisAngle(1.0, Eigen::Vector3d(1, 2, 3)), {5, -2, 1}));
+  EvaluationOptions options;
+  options.metric = MetricKind::kRpe;
+  options.rpe.delta = 10;
+  // E = (Q_i⁻¹ Q_j)⁻¹ (P_i⁻¹ P_j) with P = T Q gives E = I: zero translation error and angle.
+  for (PoseRelation relation : {PoseRelation::kTranslation, PoseRelation::kAngleDeg}) {
+    options.relation = relation;
+    const EvaluationResult r = Evaluate(ref.View(), est.View(), options);
+    EXPECT_EQ(r.rpe_pairs.size(), 19u);  // ids 0, 10, ..., 190: 19 consecutive pairs
+    EXPECT_LT(r.stats.max, 1e-9) << ToString(relation);
+    ASSERT_EQ(r.stamps_end_ns.size(), r.stamps_ns.size());
+    EXPECT_EQ(r.stamps_end_ns[0] - r.stamps_ns[0], 10 * kPeriodNs);
+  }
+  // The APE of the same pair is not zero: the motion is not aligned away.
+  options.metric = MetricKind::kApe;
+  options.relation = PoseRelation::kTranslation;
+  EXPECT_GT(Evaluate(ref.View(), est.View(), options).stats.min, 1.0);
+}
+
+TEST(EvaluateTest, AseOfAVelocityOffsetIsItsNorm) {
+  const traj::Trajectory ref = MakeTrajectory(Helix(100), true);
+  std::vector<PoseSpec> offset = Helix(100);
+  for (PoseSpec& s : offset) s.v += Eigen::Vector3d(0, 0.6, 0.8);
+  const traj::Trajectory est = MakeTrajectory(offset, true);
+  EvaluationOptions options;
+  options.metric = MetricKind::kAse;
+  const EvaluationResult r = Evaluate(ref.View(), est.View(), options);
+  ASSERT_TRUE(r.ase.has_value());
+  EXPECT_TRUE(r.ase->has_rotation);
+  EXPECT_TRUE(r.ase->has_velocity);
+  EXPECT_EQ(r.velocity_source, "given");
+  EXPECT_EQ(r.relation, "state");
+  // Same R and p: ASE_i = |R_qᵀ (v_p − v_q)| = |(0, 0.6, 0.8)| = 1 (a rotation keeps the norm).
+  for (size_t k = 0; k < r.errors.size(); ++k) {
+    EXPECT_NEAR(r.errors[k], 1.0, 1e-12);
+    EXPECT_NEAR(r.ase->velocity[k], 1.0, 1e-12);
+    EXPECT_NEAR(r.ase->position[k], 0.0, 1e-12);
+    EXPECT_NEAR(r.ase->rotation[k], 0.0, 1e-12);
+  }
+  // Pose-only: rotation and position only, so zero.
+  options.pose_only = true;
+  const EvaluationResult pose = Evaluate(ref.View(), est.View(), options);
+  EXPECT_FALSE(pose.ase->has_velocity);
+  EXPECT_EQ(pose.relation, "rotation+position");
+  EXPECT_LT(pose.stats.max, 1e-12);
+}
+
+TEST(EvaluateTest, ValidateNamesTheFirstBadField) {
+  EvaluationOptions options;
+  EXPECT_NO_THROW(options.Validate());
+  options.association.max_diff_ns = -1;
+  ExpectOptionError([&] { options.Validate(); }, "AssociationOptions", "max_diff_ns");
+  options = {};
+  options.alignment.n_align = 5;  // without a method
+  ExpectOptionError([&] { options.Validate(); }, "AlignmentOptions", "n_align");
+  options.alignment.n_align = -1;
+  options.alignment.method = AlignmentMethod::kSE3;
+  ExpectOptionError([&] { options.Validate(); }, "AlignmentOptions", "n_align");
+  options = {};
+  options.pose_only = true;
+  options.estimate_velocity_body_frame = true;
+  ExpectOptionError([&] { options.Validate(); }, "EvaluationOptions", "pose_only");
+  options = {};
+  options.continuous_reference = true;
+  options.reference_velocity = ReferenceVelocitySource::kGiven;
+  ExpectOptionError([&] { options.Validate(); }, "EvaluationOptions", "continuous_reference");
+  // The RPE's δ is checked for RPE only.
+  options = {};
+  options.rpe.delta = 1.5;  // not a whole number of frames
+  EXPECT_NO_THROW(options.Validate());
+  options.metric = MetricKind::kRpe;
+  ExpectOptionError([&] { options.Validate(); }, "RpeOptions", "delta");
+  options.rpe.delta_unit = DeltaUnit::kDegrees;
+  EXPECT_NO_THROW(options.Validate());
+  options.rpe.delta = 181;
+  ExpectOptionError([&] { options.Validate(); }, "RpeOptions", "delta");
+  // Evaluate validates before any work.
+  const traj::Trajectory ref = MakeTrajectory(Helix(10));
+  ExpectOptionError([&] { Evaluate(ref.View(), ref.View(), options); }, "RpeOptions", "delta");
+}
+
+TEST(EvaluateTest, AssociationFromSecondsRoundsToNanosecondsAndReadsBack) {
+  const AssociationOptions a = AssociationOptions::FromSeconds(0.02, -1.5);
+  EXPECT_EQ(a.max_diff_ns, 20'000'000);
+  EXPECT_EQ(a.offset_ns, -1'500'000'000);
+  // ns / 1e9 is the double nearest to the decimal: the seconds given, exactly.
+  EXPECT_EQ(a.max_diff_s(), 0.02);
+  EXPECT_EQ(a.offset_s(), -1.5);
+  EXPECT_EQ(AssociationOptions{}.max_diff_s(), 0.01);
+  ExpectOptionError([] { (void)AssociationOptions::FromSeconds(std::nan(""), 0); }, "AssociationOptions",
+                    "max_diff_ns");
+  ExpectOptionError([] { (void)AssociationOptions::FromSeconds(0.01, 1e12); }, "AssociationOptions", "offset_ns");
+}
+
+TEST(EvaluateTest, JsonAndErrorsCsvRepeatTheResult) {
+  const traj::Trajectory ref = MakeTrajectory(Helix(50));
+  const traj::Trajectory est = MakeTrajectory(Moved(Helix(50), Eigen::Quaterniond::Identity(), {0, 0, 0.25}));
+  EvaluationReport report;
+  report.reference_path = "ref.txt";
+  report.reference_poses = ref.size();
+  report.estimate_path = "est.txt";
+  report.estimate_poses = est.size();
+  report.options.association = AssociationOptions::FromSeconds(0.02, 0.0);
+  report.result = Evaluate(ref.View(), est.View(), report.options);
+  const nlohmann::json j = nlohmann::json::parse(EvaluationJson(std::span<const EvaluationReport>(&report, 1)));
+  EXPECT_EQ(j["command"], "ape");
+  EXPECT_EQ(j["association"]["max_diff"].get<double>(), 0.02);
+  EXPECT_EQ(j["association"]["pairs"], 50);
+  EXPECT_EQ(j["association"]["method"], "nearest");
+  EXPECT_EQ(j["alignment"]["method"], "none");
+  EXPECT_NEAR(j["stats"]["rmse"].get<double>(), 0.25, 1e-12);
+  EXPECT_EQ(j["stats"]["n"], 50);
+
+  const std::string csv = EvaluationErrorsCsv(std::span<const EvaluationReport>(&report, 1));
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), "stamp,error");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 51);
+  EXPECT_EQ(csv.substr(csv.find('\n') + 1, 18), "1.000000000,0.25\n1");
+  // Two reports: the estimate names each row.
+  const std::vector<EvaluationReport> two = {report, report};
+  const std::string both = EvaluationErrorsCsv(two);
+  EXPECT_EQ(both.substr(0, both.find('\n')), "estimate,stamp,error");
+  EXPECT_EQ(std::count(both.begin(), both.end(), '\n'), 101);
+  EXPECT_EQ(both.substr(both.find('\n') + 1, 8), "est.txt,");
+}
+
+TEST(EvaluateTest, NamesOfTheEnumsRoundTrip) {
+  for (ReferenceVelocitySource s : {ReferenceVelocitySource::kAuto, ReferenceVelocitySource::kGiven,
+                                    ReferenceVelocitySource::kChebyshev, ReferenceVelocitySource::kCentral}) {
+    EXPECT_EQ(ReferenceVelocitySourceFromString(ToString(s)), s);
+  }
+  // evo's letters of the RPE's δ unit, as both faces take them.
+  EXPECT_EQ(DeltaUnitFromString("f"), DeltaUnit::kFrames);
+  EXPECT_EQ(DeltaUnitFromString("m"), DeltaUnit::kMeters);
+  EXPECT_EQ(DeltaUnitFromString("d"), DeltaUnit::kDegrees);
+  EXPECT_EQ(DeltaUnitFromString("r"), DeltaUnit::kRadians);
+  EXPECT_EQ(DeltaUnitFromString("meters"), DeltaUnit::kMeters);
+  EXPECT_EQ(DeltaUnitFromString("x"), std::nullopt);
+  EXPECT_EQ(DeltaUnitFromString("m2"), std::nullopt);
+}
+
+}  // namespace
+}  // namespace cheval::eval

@@ -1,0 +1,216 @@
+// eval/velocity.h against closed forms (docs/velocity.md): central differences and Savitzky–Golay
+// on polynomials they reproduce exactly, a fixed-degree Chebyshev fit differentiated exactly, the
+// output trajectory (own stamps as read, slerp between neighbours elsewhere), the JSON, and the
+// options' validation naming the field.
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cheval/common/error.h"
+#include "cheval/eval/velocity.h"
+#include "eval_test_util.h"
+#include "expect_option_error.h"
+
+namespace cheval::eval {
+namespace {
+
+using cheval::testing::ExpectOptionError;
+using testing::AxisAngle;
+using testing::MakeTrajectory;
+using testing::PoseSpec;
+
+// p(t) = (1 + 2t − t³, 3t², −t) at `stamps_ns` (t in s from 0), orientation rotating about z at
+// 0.5 rad/s; its velocity is (2 − 3t², 6t, −1).
+traj::Trajectory Cubic(const std::vector<int64_t>& stamps_ns, bool orientation = true) {
+  std::vector<PoseSpec> poses;
+  for (int64_t stamp : stamps_ns) {
+    const double t = static_cast<double>(stamp) * 1e-9;
+    PoseSpec s;
+    s.stamp_ns = stamp;
+    s.p = {1 + 2 * t - t * t * t, 3 * t * t, -t};
+    s.q = AxisAngle(0.5 * t, Eigen::Vector3d::UnitZ());
+    poses.push_back(s);
+  }
+  return MakeTrajectory(poses, false, orientation);
+}
+
+Eigen::Vector3d CubicVelocity(int64_t stamp_ns) {
+  const double t = static_cast<double>(stamp_ns) * 1e-9;
+  return {2 - 3 * t * t, 6 * t, -1};
+}
+
+// n stamps 10 ms apart, every third one 3 ms late (uneven sampling).
+std::vector<int64_t> Stamps(int n) {
+  std::vector<int64_t> stamps;
+  for (int i = 0; i < n; ++i) stamps.push_back(i * 10'000'000 + (i % 3 == 1 ? 3'000'000 : 0));
+  return stamps;
+}
+
+TEST(VelocityTest, CentralDifferencesAreExactOnAnEvenlySampledQuadratic) {
+  // On a quadratic with equal spacing h: (p(t+h) − p(t−h)) / 2h = p'(t) exactly; at the ends the
+  // one-sided difference is p' at the midpoint of the two samples.
+  std::vector<PoseSpec> poses;
+  for (int i = 0; i < 50; ++i) {
+    const double t = 0.02 * i;
+    poses.push_back({i * 20'000'000, {t * t, 3 * t, 1.0}});
+  }
+  const traj::Trajectory trajectory = MakeTrajectory(poses);
+  VelocityOptions options;
+  options.method = VelocityMethod::kCentral;
+  const VelocityEstimate e = EstimateVelocity(trajectory.View(), options);
+  ASSERT_EQ(e.velocities.cols(), 50);
+  EXPECT_FALSE(e.curve.has_value());
+  EXPECT_EQ(e.positions.cols(), 0);
+  for (int i = 1; i < 49; ++i) {
+    EXPECT_NEAR(e.velocities(0, i), 2 * 0.02 * i, 1e-12) << i;
+    EXPECT_NEAR(e.velocities(1, i), 3.0, 1e-12);
+    EXPECT_NEAR(e.velocities(2, i), 0.0, 1e-12);
+  }
+  EXPECT_NEAR(e.velocities(0, 0), 2 * 0.01, 1e-12);
+  EXPECT_NEAR(e.velocities(0, 49), 2 * (0.02 * 48 + 0.01), 1e-12);
+}
+
+TEST(VelocityTest, SavitzkyGolayReproducesACubicOnUnevenStamps) {
+  // A local least-squares cubic in time fits a cubic exactly, whatever the spacing.
+  const traj::Trajectory trajectory = Cubic(Stamps(100));
+  VelocityOptions options;
+  options.method = VelocityMethod::kSavitzkyGolay;
+  const VelocityEstimate e = EstimateVelocity(trajectory.View(), options);
+  for (Eigen::Index i = 0; i < trajectory.size(); ++i) {
+    EXPECT_LT((e.velocities.col(i) - CubicVelocity(trajectory.View().stamps_ns()[i])).norm(), 1e-9) << i;
+  }
+  // The window in seconds: 0.3 s at 100 Hz is 30 samples, the next odd number 31; at least 5.
+  std::vector<int64_t> even;
+  for (int i = 0; i < 101; ++i) even.push_back(i * 10'000'000);
+  EXPECT_EQ(SavitzkyGolaySamples(even, 0.3), 31);
+  EXPECT_EQ(SavitzkyGolaySamples(even, 0.21), 21);
+  EXPECT_EQ(SavitzkyGolaySamples(even, 0.01), 5);
+  options.savgol_window_s = 0.3;
+  const VelocityEstimate by_seconds = EstimateVelocity(Cubic(even).View(), options);
+  EXPECT_LT((by_seconds.velocities.col(50) - CubicVelocity(even[50])).norm(), 1e-9);
+}
+
+TEST(VelocityTest, AFixedDegreeChebyshevFitIsDifferentiatedExactly) {
+  // Degree 5 >= 3: one global least-squares fit (no window given) reproduces the cubic, and its
+  // derivative is exact at the samples and between them.
+  const traj::Trajectory trajectory = Cubic(Stamps(200));
+  VelocityOptions options;
+  options.curve = CurveOptionsFromNames("5");
+  EXPECT_TRUE(options.curve.single_window);
+  const VelocityEstimate own = EstimateVelocity(trajectory.View(), options);
+  ASSERT_TRUE(own.curve.has_value());
+  for (Eigen::Index i = 0; i < trajectory.size(); ++i) {
+    EXPECT_LT((own.velocities.col(i) - CubicVelocity(trajectory.View().stamps_ns()[i])).norm(), 1e-8) << i;
+    EXPECT_LT((own.positions.col(i) - trajectory.View().positions().col(i)).norm(), 1e-10) << i;
+  }
+  const std::vector<int64_t> at = {5'000'000, 1'234'567'891, 1'985'000'000};
+  const VelocityEstimate between = EstimateVelocity(trajectory.View(), options, std::span<const int64_t>(at));
+  ASSERT_EQ(between.velocities.cols(), 3);
+  for (size_t k = 0; k < at.size(); ++k) {
+    EXPECT_LT((between.velocities.col(static_cast<Eigen::Index>(k)) - CubicVelocity(at[k])).norm(), 1e-8) << k;
+  }
+}
+
+TEST(VelocityTest, TheOutputTrajectoryKeepsWhatWasReadAndSlerpsElsewhere) {
+  const traj::Trajectory trajectory = Cubic(Stamps(200));
+  VelocityOptions options;
+  options.curve = CurveOptionsFromNames("5");
+  const VelocityEstimate own = EstimateVelocity(trajectory.View(), options);
+  const traj::Trajectory written = VelocityTrajectory(trajectory.View(), own);
+  const traj::TrajectoryView out = written.View(), in = trajectory.View();
+  ASSERT_EQ(out.size(), in.size());
+  EXPECT_TRUE(out.channels().velocity);
+  EXPECT_FALSE(out.channels().angular_velocity);
+  for (Eigen::Index i = 0; i < out.size(); ++i) {
+    EXPECT_EQ(out.stamps_ns()[i], in.stamps_ns()[i]);
+    EXPECT_EQ(out.positions().col(i), in.positions().col(i));  // as read, not fitted
+    EXPECT_EQ(out.quaternions().col(i), in.quaternions().col(i));
+    EXPECT_EQ(out.velocities().col(i), own.velocities.col(i));
+  }
+  // Midway between poses 0 (t = 0) and 1 (t = 13 ms): the slerp of the two, rotation 0.5 t about z.
+  const std::vector<int64_t> at = {6'500'000};
+  const VelocityEstimate mid = EstimateVelocity(trajectory.View(), options, std::span<const int64_t>(at));
+  const traj::Trajectory between = VelocityTrajectory(trajectory.View(), mid, std::span<const int64_t>(at));
+  ASSERT_EQ(between.size(), 1);
+  EXPECT_LT(between.View().UnitQuaternion(0).angularDistance(AxisAngle(0.5 * 0.0065, Eigen::Vector3d::UnitZ())),
+            1e-12);
+  EXPECT_EQ(between.View().positions().col(0), mid.positions.col(0));  // fitted
+  // Without orientation: the identity.
+  const traj::Trajectory bare = Cubic(Stamps(200), false);
+  const VelocityEstimate no_q = EstimateVelocity(bare.View(), options, std::span<const int64_t>(at));
+  EXPECT_EQ(VelocityTrajectory(bare.View(), no_q, std::span<const int64_t>(at)).View().UnitQuaternion(0).coeffs(),
+            Eigen::Quaterniond::Identity().coeffs());
+}
+
+TEST(VelocityTest, JsonReportsTheCurve) {
+  const traj::Trajectory trajectory = Cubic(Stamps(200));
+  VelocityOptions options;
+  options.curve = CurveOptionsFromNames("5");
+  const VelocityEstimate e = EstimateVelocity(trajectory.View(), options);
+  const nlohmann::json j =
+      nlohmann::json::parse(VelocityJson({"cubic.txt", trajectory.size(), options, 200, 0.5}, e));
+  EXPECT_EQ(j["command"], "velocity");
+  EXPECT_EQ(j["input"]["path"], "cubic.txt");
+  EXPECT_EQ(j["input"]["poses"], 200);
+  EXPECT_EQ(j["method"], "chebyshev");
+  EXPECT_EQ(j["degree_method"], "5");
+  EXPECT_EQ(j["evaluated_at"], 200);
+  EXPECT_EQ(j["segments"], 1);
+  EXPECT_EQ(j["windows"], 1);
+  EXPECT_EQ(j["degrees"], nlohmann::json({5, 5, 5}));
+  // 3 n positions over the values the curve stores.
+  EXPECT_DOUBLE_EQ(j["compression_ratio"].get<double>(), 600.0 / static_cast<double>(e.curve->stored_values()));
+  EXPECT_EQ(j["seconds"], 0.5);
+  EXPECT_FALSE(j.contains("angular"));
+}
+
+TEST(VelocityTest, DegreeNamesRoundTrip) {
+  EXPECT_EQ(CurveOptionsFromNames("auto").degree_method, cheb::DegreeMethod::kCrossValidation);
+  EXPECT_EQ(CurveOptionsFromNames("cv").degree_method, cheb::DegreeMethod::kCrossValidation);
+  EXPECT_EQ(CurveOptionsFromNames("chop").degree_method, cheb::DegreeMethod::kChop);
+  const cheb::CurveOptions fixed = CurveOptionsFromNames("12", 2.0);
+  EXPECT_EQ(fixed.degree_method, cheb::DegreeMethod::kFixed);
+  EXPECT_EQ(fixed.fixed_degree, 12);
+  EXPECT_EQ(fixed.window_s, 2.0);
+  EXPECT_FALSE(fixed.single_window);  // a window is given: windowed fits
+  for (const char* name : {"auto", "chop", "12"}) EXPECT_EQ(DegreeName(CurveOptionsFromNames(name)), name);
+  for (const char* bad : {"foo", "-1", "12x", ""}) {
+    ExpectOptionError([&] { (void)CurveOptionsFromNames(bad); }, "CurveOptions", "degree_method");
+  }
+  for (VelocityMethod m : {VelocityMethod::kChebyshev, VelocityMethod::kCentral, VelocityMethod::kSavitzkyGolay}) {
+    EXPECT_EQ(VelocityMethodFromString(ToString(m)), m);
+  }
+}
+
+TEST(VelocityTest, OptionErrorsNameTheField) {
+  VelocityOptions options;
+  options.method = VelocityMethod::kSavitzkyGolay;
+  options.savgol_window = 4;
+  ExpectOptionError([&] { options.Validate(); }, "VelocityOptions", "savgol_window");
+  options.savgol_window_s = -1.0;
+  ExpectOptionError([&] { options.Validate(); }, "VelocityOptions", "savgol_window_s");
+  options = {};
+  options.method = VelocityMethod::kSavitzkyGolay;
+  options.angular = true;
+  ExpectOptionError([&] { options.Validate(); }, "VelocityOptions", "angular");
+  // Central differences only at the trajectory's own stamps; angular needs orientations.
+  const traj::Trajectory trajectory = Cubic(Stamps(20));
+  const std::vector<int64_t> at = {5'000'000};
+  options = {};
+  options.method = VelocityMethod::kCentral;
+  ExpectOptionError([&] { (void)EstimateVelocity(trajectory.View(), options, std::span<const int64_t>(at)); },
+                    "VelocityOptions", "method");
+  options.angular = true;
+  const traj::Trajectory bare = Cubic(Stamps(20), false);
+  ExpectOptionError([&] { (void)EstimateVelocity(bare.View(), options); }, "VelocityOptions", "angular");
+  // Too few samples for the window is the data's fault: ComputeError.
+  options = {};
+  options.method = VelocityMethod::kSavitzkyGolay;
+  EXPECT_THROW((void)EstimateVelocity(trajectory.View(), options), ComputeError);
+}
+
+}  // namespace
+}  // namespace cheval::eval
