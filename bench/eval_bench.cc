@@ -103,7 +103,7 @@ void BM_ApeSE3InMemory(benchmark::State& state) {
 BENCHMARK(BM_ApeSE3InMemory)->Arg(12'500)->Arg(50'000)->Arg(200'000)->Arg(800'000)->Arg(3'200'000)->Unit(benchmark::kMillisecond);
 
 // Association alone: sorted lists (the usual case, O(n + m)) and a shuffled estimate (O(n log m)),
-// against evo's O(n·m) scan which takes 55 s at 200,000 poses (METRICS.md §2).
+// against evo's O(n·m) scan which takes 55 s at 200,000 poses (docs/evaluation.md, "Association").
 void Associate(benchmark::State& state, bool shuffled) {
   const int64_t n = state.range(0);
   std::vector<int64_t> ref(static_cast<size_t>(n)), est(static_cast<size_t>(n));

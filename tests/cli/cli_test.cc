@@ -269,11 +269,11 @@ TEST_F(CliTest, InfoReadsSharedDataWithStatedCounts) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const nlohmann::json all = nlohmann::json::parse(Slurp(Path("all.json")));
   ASSERT_TRUE(all.is_array());
-  EXPECT_EQ(all[0]["poses"], 20957);     // evo/SOURCE.md
+  EXPECT_EQ(all[0]["poses"], 20957);     // the pose count ../shared/data/evo/SOURCE.md states
   EXPECT_EQ(all[0]["duplicate_stamps"], 1);  // stamp 1311868229.5760 appears twice (lines 10862-10863)
   EXPECT_EQ(all[1]["poses"], 16702);
   EXPECT_EQ(all[1]["has_velocity"], true);
-  // Last minus first stamp, 1403715608412143104 - 1403715524907143168 ns (SOURCE.md rounds to 83.50 s).
+  // Last minus first stamp, 1403715608412143104 - 1403715524907143168 ns (the data's SOURCE.md rounds to 83.50 s).
   EXPECT_DOUBLE_EQ(all[1]["duration_s"].get<double>(), 83.504999936);
 }
 

@@ -227,7 +227,7 @@ TEST_F(CompressCliTest, EurocGroundTruthCompresses) {
   const RunResult automatic = Cheval("compress " + euroc + " -o " + Path("a.json") + " --json " + Path("a.r.json"));
   ASSERT_EQ(automatic.exit_code, 0) << automatic.err;
   const nlohmann::json a = nlohmann::json::parse(Slurp(Path("a.r.json")));
-  EXPECT_EQ(a["input"]["poses"], 16702);  // ov_data/SOURCE.md
+  EXPECT_EQ(a["input"]["poses"], 16702);  // the pose count ../shared/data/ov_data/SOURCE.md states
   // EuRoC's ground truth is smooth to ~2 µm (estimated noise), so the automatic fit keeps detail:
   // measured ratio 2.7, max error 0.21 mm.
   EXPECT_GT(a["compression_ratio"].get<double>(), 2.0);

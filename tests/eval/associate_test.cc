@@ -1,5 +1,5 @@
 // Time association: evo's semantics checked against a brute-force implementation written here from
-// METRICS.md §2 (iterate the shorter list, nearest stamp, first on ties, inclusive max_diff,
+// docs/evaluation.md, "Association" (iterate the shorter list, nearest stamp, first on ties, inclusive max_diff,
 // est + offset ≈ ref), on sorted, unsorted and duplicated stamps; plus hand-checked cases.
 #include "cheval/eval/associate.h"
 
@@ -16,7 +16,7 @@ namespace {
 
 constexpr int64_t kMs = 1'000'000;
 
-// evo's sync.matching_time_indices as METRICS.md §2 states it, O(n·m).
+// evo's sync.matching_time_indices as docs/evaluation.md ("Association") states it, O(n·m).
 Association BruteForce(const std::vector<int64_t>& ref, const std::vector<int64_t>& est, int64_t max_diff,
                        int64_t offset) {
   const bool est_longer = est.size() > ref.size();

@@ -6,7 +6,7 @@ Usage: evo_parity_test.py CHEVAL_EXE DATA_DIR
 The result zips hold evo's stats.json and its per-pair error arrays (`.npz` files that are plain
 `.npy` arrays, read here with the standard library only: zipfile + struct). For every zip the same
 evaluation is run with `cheval ... --json --errors` and every statistic and every per-pair error
-must agree to 1e-9 relative (METRICS.md). Nothing is copied from the references: cheval computes
+must agree to 1e-9 relative (docs/evaluation.md, "Parity with evo"). Nothing is copied from the references: cheval computes
 from the trajectory files.
 
 - evo/res_files/{orb,sptam}_ape.zip: APE translation, SE(3) Umeyama, KITTI 00 (evo 2018).

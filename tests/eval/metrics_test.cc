@@ -1,4 +1,4 @@
-// APE, RPE, drift, ASE and statistics from their definitions (METRICS.md §4–§8): hand-checkable
+// APE, RPE, drift, ASE and statistics from their definitions (docs/evaluation.md, "Metrics" and "Statistics"): hand-checkable
 // cases, a trajectory against itself is 0, invariances (SE(3)-aligned APE under a rigid motion of
 // the estimate, Sim(3) also under scale, RPE under any rigid motion without alignment), and the RPE
 // pair selection against brute-force transcriptions of evo's filters.

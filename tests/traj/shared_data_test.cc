@@ -1,5 +1,5 @@
 // Every text trajectory file in ../shared/data is read with the options docs/data.md documents, and
-// gives the number of poses its SOURCE.md states and the first/last stamps printed in the file
+// gives the number of poses its data set's own SOURCE.md (shipped with the data) states and the first/last stamps printed in the file
 // (converted to ns exactly, independently, with Python's Decimal when this table was made).
 #include <string>
 

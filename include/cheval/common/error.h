@@ -64,7 +64,7 @@ class OptionError : public UsageError {
   const std::string& options() const { return options_; }
   const std::string& field() const { return field_; }
   const std::string& rule() const { return rule_; }
-  /// The message with the field spelled as `name` (a flag "--degree", a keyword "degree").
+  /// The message with the field spelled as `name` (a flag such as `--degree`, a keyword such as `degree`).
   std::string Message(const std::string& name) const { return name + " " + rule_; }
 
  private:

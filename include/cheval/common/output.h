@@ -53,7 +53,7 @@ enum class OutputKind {
   kReplacedFolder,  ///< a folder replaced whole if it exists (StagedFolder, FolderExisting::kReplace)
 };
 
-/// An output as the face names it: `label` is the face's own name for it ("--json", "json_path"; may
+/// An output as the face names it: `label` is the face's own name for it (`--json`, `json_path`; may
 /// be empty) and is used only in messages. An empty `path` means "not given" and is skipped.
 struct OutputPath {
   std::string label;

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// One evaluation end to end, the data flow of DESIGN.md: two trajectories -> association (index
+/// One evaluation end to end, the data flow of an evaluation: two trajectories -> association (index
 /// pairs) -> reference velocity if the metric needs it -> alignment (a similarity applied to R, p, v)
 /// -> per-pair errors -> statistics. The CLI's `ape`, `rpe` and `ase` are this call plus printing
 /// (docs/evaluation.md).
