@@ -29,4 +29,8 @@ std::vector<int64_t> ReadQueryStamps(const std::string& path) {
   }
 }
 
+void RefuseSharedPaths(const std::vector<std::string>& inputs, const std::vector<OutputPath>& outputs) {
+  CheckOutputs(inputs, outputs);
+}
+
 }  // namespace cheval::cli

@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cheval/common/output.h"
 #include "cheval/traj/io.h"
 #include "option_names.h"
 
@@ -30,6 +31,11 @@ void AddInputFlags(CLI::App* command, InputFlags* flags, const std::string& pref
 /// Stamps to evaluate at (`--at FILE`): a file of one stamp (seconds) per line, or any trajectory
 /// file (its stamps). InputError with the stamps file's message when it is neither.
 std::vector<int64_t> ReadQueryStamps(const std::string& path);
+
+/// Refuses, before any work, an output that is one of the command's `inputs` or the same file as another
+/// output: UsageError (exit 1) naming both (common/output.h, CheckOutputs; each output labelled with its
+/// flag). Empty paths are options not given and are skipped.
+void RefuseSharedPaths(const std::vector<std::string>& inputs, const std::vector<OutputPath>& outputs);
 
 /// The action a subcommand registers; main runs it after parsing, inside its error mapping.
 using Action = std::function<void()>;

@@ -78,6 +78,7 @@ void RegisterCompress(CLI::App& app, Action* action) {
       cheb::CompressOptions options;
       options.tolerance = flags->tolerance;
       options.Validate();  // before any work
+      RefuseSharedPaths({flags->input, flags->format.kitti_times}, {{"-o", flags->output}, {"--json", flags->json_path}});
       const traj::Trajectory trajectory = traj::ReadTrajectory(flags->input, flags->format.ToReadOptions());
       const traj::TrajectoryView view = trajectory.View();
       if (!view.has_stamps()) throw ComputeError("compress needs stamps; give the KITTI times with --kitti-times");

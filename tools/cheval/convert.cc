@@ -44,6 +44,8 @@ void RegisterConvert(CLI::App& app, Action* action) {
       if (!flags->times_output.empty() && to != traj::Format::kKitti) {
         throw UsageError("--times-output is only for --to kitti");
       }
+      RefuseSharedPaths({flags->input, flags->format.kitti_times},
+                        {{"-o", flags->output}, {"--times-output", flags->times_output}});
       const traj::Trajectory trajectory = traj::ReadTrajectory(flags->input, flags->format.ToReadOptions());
       // Everything is formatted before anything is written, so an error leaves no file behind.
       const std::string text = traj::FormatTrajectory(trajectory.View(), to);

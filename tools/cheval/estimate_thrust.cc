@@ -64,6 +64,7 @@ void RegisterEstimateThrust(CLI::App& app, Action* action) {
   thrust->add_option("--json", flags->json, "Write the result as JSON");
   thrust->callback([flags, action] {
     *action = [flags] {
+      RefuseSharedPaths({flags->data, flags->params}, {{"--json", flags->json}});
       const estim::ThrustFlight flight = estim::ReadDidoFlight(flags->data, flags->params);
       const estim::ThrustEstimate e = estim::EstimateThrust(flight, flags->options);
       fmt::print("samples             {}\nposition meas.      {} ({} Hz, sigma {} m, added noise {} m)\n",

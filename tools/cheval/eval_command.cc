@@ -46,6 +46,12 @@ eval::EvaluationOptions ToEvaluationOptions(eval::MetricKind metric, const EvalF
   return options;
 }
 
+std::vector<std::string> EvalInputPaths(const EvalFlags& flags) {
+  std::vector<std::string> paths{flags.reference, flags.both.kitti_times, flags.ref.kitti_times, flags.est.kitti_times};
+  paths.insert(paths.end(), flags.estimates.begin(), flags.estimates.end());
+  return paths;
+}
+
 EvalInputs ReadEvalInputs(CLI::App* command, const EvalFlags& flags) {
   const traj::ReadOptions ref_options = SideOptions(command, flags, "ref-", flags.ref);
   const traj::ReadOptions est_options = SideOptions(command, flags, "est-", flags.est);
@@ -123,6 +129,7 @@ void PrintComparison(const std::vector<Evaluated>& all) {
 
 void Run(CLI::App* command, eval::MetricKind metric, const EvalFlags& flags) {
   const eval::EvaluationOptions options = ToEvaluationOptions(metric, flags);
+  RefuseSharedPaths(EvalInputPaths(flags), {{"--json", flags.json_path}, {"--errors", flags.errors_path}});
   const EvalInputs inputs = ReadEvalInputs(command, flags);
   const traj::Trajectory& ref = inputs.reference;
   const std::vector<traj::Trajectory>& ests = inputs.estimates;

@@ -55,6 +55,10 @@ struct EvalInputs {
   std::vector<traj::Trajectory> estimates;
 };
 
+/// Every file an evaluation reads: the reference, the estimates and the KITTI times files of both sides
+/// (empty when not given), for RefuseSharedPaths.
+std::vector<std::string> EvalInputPaths(const EvalFlags& flags);
+
 /// Reads the reference and the estimates concurrently with the read options of each side (errors
 /// are reported in argument order).
 EvalInputs ReadEvalInputs(CLI::App* command, const EvalFlags& flags);

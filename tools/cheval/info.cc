@@ -68,6 +68,9 @@ void RegisterInfo(CLI::App& app, Action* action) {
   command->add_option("--json", flags->json_path, "Also write the summary as JSON (an array for several files)");
   command->callback([flags, action] {
     *action = [flags] {
+      std::vector<std::string> inputs = flags->paths;
+      inputs.push_back(flags->input.kitti_times);
+      RefuseSharedPaths(inputs, {{"--json", flags->json_path}});
       const traj::ReadOptions options = flags->input.ToReadOptions();
       std::vector<traj::FileSummary> all;
       for (const std::string& path : flags->paths) {

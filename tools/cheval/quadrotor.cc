@@ -79,6 +79,9 @@ void RegisterSimQuadrotor(CLI::App& app, Action* action) {
   quad->add_option("-o,--output", flags->output, "Data folder to write")->required();
   quad->callback([flags, action] {
     *action = [flags] {
+      // A data folder from an earlier run is replaced whole (estim::WriteQuadrotorData): the vehicle
+      // file must not be in it.
+      RefuseSharedPaths({flags->vehicle}, {{"-o", flags->output, OutputKind::kReplacedFolder}});
       const estim::Vehicle vehicle = estim::ReadVehicle(flags->vehicle);
       const estim::QuadrotorData data = sim::SimulateQuadrotor(vehicle, SimOptions(*flags));
       estim::WriteQuadrotorData(data, flags->output);
@@ -111,6 +114,13 @@ void RegisterEstimate(CLI::App& app, Action* action) {
     const bool has_vehicle = quad->get_option("--vehicle")->count() > 0;
     *action = [flags, has_scenario, has_data, has_vehicle] {
       if (has_scenario == has_data) throw UsageError("give exactly one of --scenario NAME or --data DIR");
+      std::vector<std::string> inputs{flags->vehicle};
+      if (has_data) {
+        for (const char* name : {"vehicle.json", "landmarks.csv", "measurements.csv", "initial.csv", "truth.csv"}) {
+          inputs.push_back((std::filesystem::path(flags->data) / name).string());
+        }
+      }
+      RefuseSharedPaths(inputs, {{"-o", flags->states_output}, {"--json", flags->json}});
       estim::QuadrotorData data;
       if (has_data) {
         data = estim::ReadQuadrotorData(flags->data);

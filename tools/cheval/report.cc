@@ -24,6 +24,7 @@ void Run(CLI::App* command, const ReportFlags& flags) {
   options.generator = fmt::format("cheval {}", CHEVAL_VERSION);
   options.option_names = FlagNames();  // the notes quote library messages
   options.Validate();
+  RefuseSharedPaths(EvalInputPaths(flags.eval), {{"-o", flags.output}});
   const EvalInputs inputs = ReadEvalInputs(command, flags.eval);
   std::vector<report::ReportInput> estimates;
   for (size_t k = 0; k < inputs.estimates.size(); ++k) {

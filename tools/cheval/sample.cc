@@ -42,6 +42,7 @@ void RegisterSample(CLI::App& app, Action* action) {
       if (flags->rate_hz && !(*flags->rate_hz > 0.0 && std::isfinite(*flags->rate_hz))) {
         throw UsageError(fmt::format("--rate must be a positive number of Hz, got {}", *flags->rate_hz));
       }
+      RefuseSharedPaths({flags->model, flags->at_path}, {{"-o", flags->output}});
       const cheb::TrajectoryModel model = cheb::ReadModel(flags->model);
       if (model.dimension != 3) {
         throw InputError(

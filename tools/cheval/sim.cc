@@ -80,6 +80,9 @@ void RegisterSim(CLI::App& app, Action* action) {
         throw UsageError(fmt::format("--estimate-drift: give one value or one per --estimate ({}), got {}",
                                      n_estimates, flags->estimate_drifts.size()));
       }
+      std::vector<OutputPath> paths{{"-o", flags->output}, {"--truth", flags->truth_output}};
+      for (const std::string& path : flags->estimate_outputs) paths.push_back({"--estimate", path});
+      RefuseSharedPaths({}, paths);
       sim::MotionOptions options;
       options.kind = *sim::MotionKindFromString(flags->kind);
       options.seed = flags->seed;

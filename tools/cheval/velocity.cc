@@ -45,6 +45,8 @@ void Run(const VelocityFlags& flags) {
   const auto start = std::chrono::steady_clock::now();
   const eval::VelocityOptions options = ToOptions(flags);
   options.Validate();
+  RefuseSharedPaths({flags.input, flags.format.kitti_times, flags.at_path},
+                    {{"-o", flags.output}, {"--json", flags.json_path}});
   const traj::Trajectory trajectory = traj::ReadTrajectory(flags.input, flags.format.ToReadOptions());
   const traj::TrajectoryView view = trajectory.View();
   std::optional<std::vector<int64_t>> at;
