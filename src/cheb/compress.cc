@@ -10,6 +10,7 @@
 #include <utility>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "cheval/cheb/chebyshev.h"
 #include "cheval/cheb/fit.h"
@@ -327,6 +328,38 @@ Compression Compress(std::span<const int64_t> stamps_ns, const Eigen::Ref<const 
   result.model_numbers = ModelNumberCount(result.model);
   result.ratio = static_cast<double>(result.input_numbers) / static_cast<double>(result.model_numbers);
   return result;
+}
+
+std::string CompressionJson(const CompressionRun& run, const Compression& c) {
+  const TrajectoryModel& model = c.model;
+  std::vector<int> degrees;
+  size_t windows = 0;
+  for (const ModelSegment& segment : model.segments) {
+    windows += segment.windows.size();
+    for (const ModelWindow& w : segment.windows) {
+      for (size_t k = 0; k < w.values.size(); ++k) degrees.push_back(w.degree(k));
+    }
+  }
+  nlohmann::json j;
+  j["command"] = "compress";
+  j["input"] = {{"path", run.input_path}, {"poses", run.input_poses}, {"has_orientation", run.input_has_orientation}};
+  j["model"] = {{"path", run.model_path}, {"bytes", run.model_bytes}};
+  j["tolerance_m"] = run.tolerance_m ? nlohmann::json(*run.tolerance_m) : nlohmann::json(nullptr);
+  j["segments"] = model.segments.size();
+  j["windows"] = windows;
+  j["degrees"] = degrees;
+  j["input_numbers"] = c.input_numbers;
+  j["model_values"] = ModelValueCount(model);
+  j["model_numbers"] = c.model_numbers;
+  j["compression_ratio"] = c.ratio;
+  j["max_error_m"] = c.error.max;
+  j["rms_error_m"] = c.error.rms;
+  j["worst_stamp"] = traj::FormatSeconds(c.error.worst_stamp_ns);
+  j["noise_sigma_m"] =
+      std::vector<double>(model.noise_sigma.data(), model.noise_sigma.data() + model.noise_sigma.size());
+  j["automatic"] = c.automatic;
+  j["seconds"] = run.seconds;
+  return j.dump(2) + "\n";
 }
 
 }  // namespace cheval::cheb

@@ -6,7 +6,6 @@
 #include <fmt/format.h>
 
 #include <vector>
-#include <nlohmann/json.hpp>
 
 #include "cheval/cheb/compress.h"
 #include "cheval/common/error.h"
@@ -24,39 +23,6 @@ struct CompressFlags {
   std::string json_path;
   InputFlags format;
 };
-
-nlohmann::json Report(const CompressFlags& flags, const traj::TrajectoryView& input, const cheb::Compression& c,
-                      size_t model_bytes, double seconds) {
-  const cheb::TrajectoryModel& model = c.model;
-  std::vector<int> degrees;
-  size_t windows = 0;
-  for (const cheb::ModelSegment& segment : model.segments) {
-    windows += segment.windows.size();
-    for (const cheb::ModelWindow& w : segment.windows) {
-      for (size_t k = 0; k < w.values.size(); ++k) degrees.push_back(w.degree(k));
-    }
-  }
-  nlohmann::json j;
-  j["command"] = "compress";
-  j["input"] = {{"path", flags.input}, {"poses", input.size()}, {"has_orientation", input.has_orientation()}};
-  j["model"] = {{"path", flags.output}, {"bytes", model_bytes}};
-  j["tolerance_m"] = flags.tolerance ? nlohmann::json(*flags.tolerance) : nlohmann::json(nullptr);
-  j["segments"] = model.segments.size();
-  j["windows"] = windows;
-  j["degrees"] = degrees;
-  j["input_numbers"] = c.input_numbers;
-  j["model_values"] = cheb::ModelValueCount(model);
-  j["model_numbers"] = c.model_numbers;
-  j["compression_ratio"] = c.ratio;
-  j["max_error_m"] = c.error.max;
-  j["rms_error_m"] = c.error.rms;
-  j["worst_stamp"] = traj::FormatSeconds(c.error.worst_stamp_ns);
-  j["noise_sigma_m"] =
-      std::vector<double>(model.noise_sigma.data(), model.noise_sigma.data() + model.noise_sigma.size());
-  j["automatic"] = c.automatic;
-  j["seconds"] = seconds;
-  return j;
-}
 
 }  // namespace
 
@@ -87,12 +53,14 @@ void RegisterCompress(CLI::App& app, Action* action) {
       const cheb::Compression result = cheb::Compress(view.stamps_ns(), positions, options);
       const std::string text = cheb::WriteModelJson(result.model);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const nlohmann::json report = Report(*flags, view, result, text.size(), seconds);
-      const std::string report_text = report.dump(2) + "\n";
+      const std::string report = cheb::CompressionJson(
+          {flags->input, view.size(), view.has_orientation(), flags->output, text.size(), flags->tolerance, seconds},
+          result);
       std::vector<traj::FileToWrite> files{{flags->output, text}};
-      if (!flags->json_path.empty()) files.push_back({flags->json_path, report_text});
+      if (!flags->json_path.empty()) files.push_back({flags->json_path, report});
       traj::WriteFilesAtomically(files);
-      const auto windows = report["windows"].get<size_t>();
+      size_t windows = 0;
+      for (const cheb::ModelSegment& segment : result.model.segments) windows += segment.windows.size();
       fmt::print(
           "{}: {} poses -> {}: {} window{} in {} segment{}, {} numbers for {} positions: compression {:.1f}x; "
           "max error {:.3g} m, RMS {:.3g} m at the input samples{}; {:.3f} s\n",

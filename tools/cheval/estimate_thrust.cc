@@ -4,11 +4,11 @@
 #include <fmt/format.h>
 
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <string>
 
 #include "cheval/common/error.h"
 #include "cheval/estim/thrust_estimator.h"
+#include "cheval/estim/thrust_json.h"
 #include "cheval/traj/io.h"
 #include "common.h"
 
@@ -21,11 +21,6 @@ struct ThrustFlags {
   std::string json;
   estim::ThrustEstimateOptions options;
 };
-
-nlohmann::json ErrorsJson(const estim::CollectiveErrors& e) {
-  return {{"mean_abs_rpm", e.mean_abs_rpm}, {"mean_abs_percent", e.mean_abs_percent}, {"rmse_rpm", e.rmse_rpm},
-          {"bias_rpm", e.bias_rpm}};
-}
 
 void PrintErrors(const char* label, const estim::CollectiveErrors& e) {
   fmt::print("{:<28}{:8.1f} rpm {:7.3f} %   RMSE {:8.1f} rpm   bias {:+8.1f} rpm\n", label, e.mean_abs_rpm,
@@ -82,28 +77,7 @@ void RegisterEstimateThrust(CLI::App& app, Action* action) {
       fmt::print("position RMSE       {:.4f} m\nvelocity RMSE       {:.4f} m/s\n", e.position_rmse_m,
                  e.velocity_rmse_mps);
       if (!e.converged) fmt::print(stderr, "cheval: warning: the solver did not converge: {}\n", e.solver_report);
-      if (!flags->json.empty()) {
-        nlohmann::json j = {{"samples", e.estimate.samples},
-                            {"position_measurements", e.position_measurements},
-                            {"imu_measurements", e.imu_measurements},
-                            {"states", e.states},
-                            {"segments", e.segments},
-                            {"degree", e.degree},
-                            {"iterations", e.iterations},
-                            {"converged", e.converged},
-                            {"seconds", e.seconds},
-                            {"mean_measured_rpm", e.mean_measured_rpm},
-                            {"collective_error_rpm", e.estimate.mean_abs_rpm},
-                            {"collective_error_percent", e.estimate.mean_abs_percent},
-                            {"collective_rmse_rpm", e.estimate.rmse_rpm},
-                            {"collective_bias_rpm", e.estimate.bias_rpm},
-                            {"baseline_flatness", ErrorsJson(e.flatness)},
-                            {"baseline_accelerometer", ErrorsJson(e.accelerometer)},
-                            {"model_floor", ErrorsJson(e.model_floor)},
-                            {"position_rmse_m", e.position_rmse_m},
-                            {"velocity_rmse_mps", e.velocity_rmse_mps}};
-        traj::WriteFileAtomically(flags->json, j.dump(2) + "\n");
-      }
+      if (!flags->json.empty()) traj::WriteFileAtomically(flags->json, estim::ThrustEstimateJson(e));
     };
   });
 }

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string>
 
 #include <Eigen/Core>
 
@@ -64,5 +65,22 @@ struct Compression {
 /// giving the max and RMS error of the most accurate model found and the estimated noise.
 Compression Compress(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen::MatrixXd>& values,
                      const CompressOptions& options = {});
+
+/// What CompressionJson reports besides the compression: the files as the caller names them and the run.
+struct CompressionRun {
+  std::string input_path;
+  Eigen::Index input_poses = 0;
+  bool input_has_orientation = false;
+  std::string model_path;
+  size_t model_bytes = 0;       ///< size of the model file's text
+  std::optional<double> tolerance_m;  ///< CompressOptions::tolerance as given
+  double seconds = 0;           ///< wall-clock time of the run as the caller measured it
+};
+
+/// The JSON object of `cheval compress --json` (docs/compress.md): command, input, model,
+/// tolerance_m, segments, windows, degrees (per window and coordinate), input_numbers, model_values,
+/// model_numbers, compression_ratio, max_error_m, rms_error_m, worst_stamp (seconds, exact),
+/// noise_sigma_m, automatic and seconds; two-space indented, with a final newline.
+std::string CompressionJson(const CompressionRun& run, const Compression& compression);
 
 }  // namespace cheval::cheb
