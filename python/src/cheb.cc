@@ -11,6 +11,7 @@
 #include "cheval/cheb/compress.h"
 #include "cheval/cheb/model.h"
 #include "cheval/common/error.h"
+#include "cheval/common/output.h"
 
 namespace cheval::python {
 namespace {
@@ -165,7 +166,7 @@ cheval.read_model; evaluate it with cheval.sample or model.curve().)")
   m.def(
       "write_model",
       [](const cheb::TrajectoryModel& model, const std::string& path) {
-        traj::WriteFileAtomically(path, cheb::WriteModelJson(model));
+        WriteOutput(path, cheb::WriteModelJson(model));
       },
       py::arg("model"), py::arg("path"), "Writes a model file atomically (OutputError when it cannot).");
 

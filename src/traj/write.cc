@@ -104,17 +104,8 @@ std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
   return out;
 }
 
-void WriteFilesAtomically(std::span<const FileToWrite> files) {
-  std::vector<OutputFile> outputs;
-  outputs.reserve(files.size());
-  for (const FileToWrite& file : files) outputs.push_back({file.path, file.text});
-  WriteOutputs(outputs);
-}
-
-void WriteFileAtomically(const std::string& path, std::string_view text) { WriteOutput(path, text); }
-
 void WriteTrajectory(const std::string& path, const TrajectoryView& trajectory, Format format) {
-  WriteFileAtomically(path, FormatTrajectory(trajectory, format));
+  WriteOutput(path, FormatTrajectory(trajectory, format));
 }
 
 }  // namespace cheval::traj

@@ -104,6 +104,29 @@ class OutputTest : public ::testing::Test {
 // ---------------------------------------------------------------------------------------------
 // Regular files.
 
+// Several outputs of one command are written as one: all, or none replaced and no temporary left.
+TEST_F(OutputTest, SeveralOutputsAreWrittenAllOrNothing) {
+  const std::string a = Path("a.txt"), b = Path("b.txt");
+  const std::vector<OutputFile> both{{a, "first\n"}, {b, "second\n"}};
+  WriteOutputs(both);
+  EXPECT_EQ(ReadWhole(a), "first\n");
+  EXPECT_EQ(ReadWhole(b), "second\n");
+
+  // The second file cannot be written (its folder does not exist): the first keeps its old text.
+  const std::string missing = Path("no_such_folder/c.txt");
+  const std::vector<OutputFile> failing{{a, "replaced\n"}, {missing, "x"}};
+  try {
+    WriteOutputs(failing);
+    ADD_FAILURE() << "expected an OutputError";
+  } catch (const OutputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(missing + ": error: cannot write: ", 0), 0u) << e.what();
+  }
+  EXPECT_EQ(ReadWhole(a), "first\n");
+  size_t entries = 0;
+  for (const auto& entry : fs::directory_iterator(dir_)) entries += entry.is_regular_file();
+  EXPECT_EQ(entries, 2u);  // a.txt and b.txt: no temporary is left behind
+}
+
 TEST_F(OutputTest, NewFileGetsTheUmaskMode) {
   const mode_t mask = ::umask(0);
   ::umask(mask);

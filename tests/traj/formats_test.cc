@@ -1,11 +1,6 @@
 // Writers and readers agree (write -> read round trips are exact), detection picks the right
 // format, and the generic column map reads what it is told to.
-#include <unistd.h>
-
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
@@ -177,45 +172,6 @@ TEST(Readers, EurocWithBiasesHasVelocity) {
   ASSERT_TRUE(t.View().has_velocity());
   EXPECT_EQ(t.View().velocities().col(1), Eigen::Vector3d(7, 8, 9));
   EXPECT_EQ(t.View().quaternions().col(0), Eigen::Vector4d(0, 0, 0, 1));  // w first in the file
-}
-
-}  // namespace
-}  // namespace cheval::traj
-
-namespace cheval::traj {
-namespace {
-
-std::string ReadWhole(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-// Several outputs of one command are written as one: all, or none replaced and no temporary left.
-TEST(WriteFilesAtomically, AllOrNothing) {
-  namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("cheval_write_files_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const std::string a = (dir / "a.txt").string(), b = (dir / "b.txt").string();
-  const std::vector<FileToWrite> both{{a, "first\n"}, {b, "second\n"}};
-  WriteFilesAtomically(both);
-  EXPECT_EQ(ReadWhole(a), "first\n");
-  EXPECT_EQ(ReadWhole(b), "second\n");
-
-  // The second file cannot be written (its folder does not exist): the first keeps its old text.
-  const std::string missing = (dir / "no_such_folder" / "c.txt").string();
-  const std::vector<FileToWrite> failing{{a, "replaced\n"}, {missing, "x"}};
-  try {
-    WriteFilesAtomically(failing);
-    ADD_FAILURE() << "expected an OutputError";
-  } catch (const OutputError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind(missing + ": error: cannot write: ", 0), 0u) << e.what();
-  }
-  EXPECT_EQ(ReadWhole(a), "first\n");
-  size_t entries = 0;
-  for (const auto& entry : fs::directory_iterator(dir)) entries += entry.is_regular_file();
-  EXPECT_EQ(entries, 2u);  // a.txt and b.txt: no temporary is left behind
-  fs::remove_all(dir);
 }
 
 }  // namespace

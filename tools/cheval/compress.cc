@@ -56,9 +56,9 @@ void RegisterCompress(CLI::App& app, Action* action) {
       const std::string report = cheb::CompressionJson(
           {flags->input, view.size(), view.has_orientation(), flags->output, text.size(), flags->tolerance, seconds},
           result);
-      std::vector<traj::FileToWrite> files{{flags->output, text}};
+      std::vector<OutputFile> files{{flags->output, text}};
       if (!flags->json_path.empty()) files.push_back({flags->json_path, report});
-      traj::WriteFilesAtomically(files);
+      WriteOutputs(files);
       size_t windows = 0;
       for (const cheb::ModelSegment& segment : result.model.segments) windows += segment.windows.size();
       fmt::print(

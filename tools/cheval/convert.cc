@@ -54,9 +54,9 @@ void RegisterConvert(CLI::App& app, Action* action) {
         if (!trajectory.channels().has_stamps) throw ComputeError("--times-output: the input has no stamps");
         for (int64_t stamp : trajectory.stamps_ns()) times += traj::FormatSeconds(stamp) + "\n";
       }
-      std::vector<traj::FileToWrite> files{{flags->output, text}};
+      std::vector<OutputFile> files{{flags->output, text}};
       if (!times.empty()) files.push_back({flags->times_output, times});
-      traj::WriteFilesAtomically(files);
+      WriteOutputs(files);
       if (!Quiet()) fmt::print(stderr, "wrote {} poses to {} ({})\n", trajectory.size(), flags->output, traj::ToString(to));
     };
   });

@@ -9,7 +9,6 @@
 #include "cheval/common/error.h"
 #include "cheval/estim/thrust_estimator.h"
 #include "cheval/estim/thrust_json.h"
-#include "cheval/traj/io.h"
 #include "common.h"
 
 namespace cheval::cli {
@@ -77,7 +76,7 @@ void RegisterEstimateThrust(CLI::App& app, Action* action) {
       fmt::print("position RMSE       {:.4f} m\nvelocity RMSE       {:.4f} m/s\n", e.position_rmse_m,
                  e.velocity_rmse_mps);
       if (!e.converged) fmt::print(stderr, "cheval: warning: the solver did not converge: {}\n", e.solver_report);
-      if (!flags->json.empty()) traj::WriteFileAtomically(flags->json, estim::ThrustEstimateJson(e));
+      if (!flags->json.empty()) WriteOutput(flags->json, estim::ThrustEstimateJson(e));
     };
   });
 }

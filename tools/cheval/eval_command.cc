@@ -152,10 +152,10 @@ void Run(CLI::App* command, eval::MetricKind metric, const EvalFlags& flags) {
 
   for (const Evaluated& e : all) PrintResult(e, ref.size());
   if (all.size() > 1) PrintComparison(all);
-  std::vector<traj::FileToWrite> files;
+  std::vector<OutputFile> files;
   if (!flags.json_path.empty()) files.push_back({flags.json_path, json_text});
   if (!flags.errors_path.empty()) files.push_back({flags.errors_path, errors_text});
-  traj::WriteFilesAtomically(files);
+  WriteOutputs(files);
 }
 
 }  // namespace

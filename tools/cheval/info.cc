@@ -79,7 +79,7 @@ void RegisterInfo(CLI::App& app, Action* action) {
         file.summary = traj::Summarize(trajectory.View());
         PrintSummary(path, file.format, file.summary);
       }
-      if (!flags->json_path.empty()) traj::WriteFileAtomically(flags->json_path, traj::SummaryJson(all));
+      if (!flags->json_path.empty()) WriteOutput(flags->json_path, traj::SummaryJson(all));
     };
   });
 }

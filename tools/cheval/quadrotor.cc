@@ -14,7 +14,6 @@
 #include "cheval/estim/quadrotor_estimator.h"
 #include "cheval/estim/quadrotor_scoring.h"
 #include "cheval/sim/quadrotor.h"
-#include "cheval/traj/io.h"
 #include "common.h"
 #include "progress.h"
 
@@ -155,10 +154,10 @@ void RegisterEstimate(CLI::App& app, Action* action) {
       // Both outputs are formatted before either is written.
       const std::string json = estim::QuadrotorEstimateJson(e, errors ? &*errors : nullptr);
       const std::string states = flags->states_output.empty() ? "" : estim::QuadrotorStatesCsv(estim::EstimatedStates(e));
-      std::vector<traj::FileToWrite> files;
+      std::vector<OutputFile> files;
       if (!flags->states_output.empty()) files.push_back({flags->states_output, states});
       if (!flags->json.empty()) files.push_back({flags->json, json});
-      traj::WriteFilesAtomically(files);
+      WriteOutputs(files);
     };
   });
 }

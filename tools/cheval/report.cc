@@ -35,7 +35,7 @@ void Run(CLI::App* command, const ReportFlags& flags) {
   const std::string page = report::RenderReportHtml(
       result.data_json,
       fmt::format("cheval report: {} estimate(s) against {}", estimates.size(), flags.eval.reference));
-  traj::WriteFileAtomically(flags.output, page);
+  WriteOutput(flags.output, page);
 
   for (size_t k = 0; k < result.ape.size(); ++k) {
     const eval::EvaluationResult& ape = result.ape[k].result;

@@ -106,9 +106,9 @@ void RegisterSim(CLI::App& app, Action* action) {
         const traj::Trajectory estimate = sim::SimulateEstimate(model, estimator);
         outputs.emplace_back(flags->estimate_outputs[k], traj::FormatTrajectory(estimate.View(), traj::Format::kTumV));
       }
-      std::vector<traj::FileToWrite> files;
+      std::vector<OutputFile> files;
       for (const auto& [path, text] : outputs) files.push_back({path, text});
-      traj::WriteFilesAtomically(files);
+      WriteOutputs(files);
       const sim::MotionOptions& used = model.options();
       if (!Quiet()) fmt::print(stderr,
                  "wrote {} measured poses ({}, {} s at {} Hz, seed {}; noise {} m, jitter {} s, {} removed by dropouts "

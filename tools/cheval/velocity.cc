@@ -64,10 +64,10 @@ void Run(const VelocityFlags& flags) {
     fmt::print(stderr, "cheval: warning: {} has no orientation; {} gets identity quaternions\n", flags.input,
                flags.output);
   }
-  std::vector<traj::FileToWrite> files;
+  std::vector<OutputFile> files;
   if (!flags.output.empty()) files.push_back({flags.output, text});
   if (!flags.json_path.empty()) files.push_back({flags.json_path, json});
-  traj::WriteFilesAtomically(files);
+  WriteOutputs(files);
   if (!estimate.curve) {
     fmt::print("{}: {} poses, method {}, {:.3f} s\n", flags.input, view.size(), flags.method, seconds);
     return;

@@ -120,7 +120,7 @@ std::string WriteModelJson(const TrajectoryModel& model);
 TrajectoryModel ParseModelJson(std::string_view text, const std::string& path);
 
 /// Reads and parses a model file (InputError when it cannot be opened or is invalid). Write one
-/// with traj::WriteFileAtomically(path, WriteModelJson(model)).
+/// with WriteOutput(path, WriteModelJson(model)) (common/output.h).
 TrajectoryModel ReadModel(const std::string& path);
 
 }  // namespace cheval::cheb

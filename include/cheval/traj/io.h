@@ -110,19 +110,4 @@ std::string FormatTrajectory(const TrajectoryView& trajectory, Format format);
 /// symlink's target is replaced (cheval/common/output.h, WriteOutputs). Throws OutputError.
 void WriteTrajectory(const std::string& path, const TrajectoryView& trajectory, Format format);
 
-/// Writes `text` to `path` atomically (as WriteTrajectory). Throws OutputError.
-void WriteFileAtomically(const std::string& path, std::string_view text);
-
-/// A file for WriteFilesAtomically: where, and the whole text.
-struct FileToWrite {
-  std::string path;
-  std::string_view text;
-};
-
-/// Writes several files as one: each text goes to a temporary file beside its path first, and only
-/// when every one is on disk are they renamed over their paths. When a file cannot be written none
-/// is replaced (files that existed keep their old content) and no temporary is left. Throws
-/// OutputError naming the file that failed (cheval/common/output.h, WriteOutputs, has the contract).
-void WriteFilesAtomically(std::span<const FileToWrite> files);
-
 }  // namespace cheval::traj
