@@ -227,6 +227,15 @@ int WriteAll(int fd, std::string_view text) {
   return 0;
 }
 
+// Finishes a new file: writes all of `text` unless `error` is set already, flushes it to disk and
+// closes the descriptor in any case; 0 or the first errno.
+int WriteSyncClose(int fd, std::string_view text, int error = 0) {
+  if (error == 0) error = WriteAll(fd, text);
+  if (error == 0 && ::fsync(fd) != 0) error = errno;
+  if (::close(fd) != 0 && error == 0) error = errno;
+  return error;
+}
+
 std::string TemporaryName(const std::string& target, std::string_view kind) {
   namespace fs = std::filesystem;
   const fs::path p(target);
@@ -267,9 +276,7 @@ Staged Stage(const std::string& shown, const Resolved& target, std::string_view 
     if (::fchown(fd, target.st.st_uid, target.st.st_gid) != 0) (void)::fchown(fd, static_cast<uid_t>(-1), target.st.st_gid);
     if (::fchmod(fd, target.st.st_mode & 07777) != 0) error = errno;
   }
-  if (error == 0) error = WriteAll(fd, text);
-  if (error == 0 && ::fsync(fd) != 0) error = errno;
-  if (::close(fd) != 0 && error == 0) error = errno;
+  error = WriteSyncClose(fd, text, error);
   if (error != 0) {
     Remove(staged);
     CannotWrite(shown, error);
@@ -454,10 +461,7 @@ void StagedFolder::Write(const std::string& name, std::string_view text) {
     CannotWrite(shown, error);
   }
   files_.emplace_back(file, slot);
-  int error = WriteAll(fd, text);
-  if (error == 0 && ::fsync(fd) != 0) error = errno;
-  if (::close(fd) != 0 && error == 0) error = errno;
-  if (error != 0) CannotWrite(shown, error);  // the destructor removes it with the staging folder
+  if (const int error = WriteSyncClose(fd, text); error != 0) CannotWrite(shown, error);  // the destructor removes it with the staging folder
 }
 
 namespace {

@@ -69,10 +69,6 @@ std::string QuadrotorStatesCsv(const std::vector<QuadrotorTruth>& states) {
 
 namespace {
 
-// The files of a data folder, in the order they are written.
-constexpr std::array<std::string_view, 5> kDataFiles = {"vehicle.json", "landmarks.csv", "measurements.csv",
-                                                        "initial.csv", "truth.csv"};
-
 // True when `folder` exists and holds nothing but files named like those of a data folder (so it is
 // one, from an earlier run): such a folder is replaced whole; any other non-empty folder is refused.
 bool IsDataFolder(const std::string& folder) {
@@ -80,7 +76,8 @@ bool IsDataFolder(const std::string& folder) {
   if (!std::filesystem::is_directory(folder, ec)) return false;
   for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
     const std::string name = entry.path().filename().string();
-    if (!entry.is_regular_file(ec) || std::find(kDataFiles.begin(), kDataFiles.end(), name) == kDataFiles.end()) {
+    const bool known = std::find(kQuadrotorDataFiles.begin(), kQuadrotorDataFiles.end(), name) != kQuadrotorDataFiles.end();
+    if (!entry.is_regular_file(ec) || !known) {
       return false;
     }
   }
@@ -91,25 +88,25 @@ bool IsDataFolder(const std::string& folder) {
 
 void WriteQuadrotorData(const QuadrotorData& data, const std::string& folder) {
   StagedFolder staged(folder);
-  staged.Write(std::string(kDataFiles[0]), VehicleToJson(data.vehicle));
+  staged.Write(std::string(kQuadrotorDataFiles[0]), VehicleToJson(data.vehicle));
   std::string text = "id,x,y,z\n";
   for (size_t i = 0; i < data.landmarks.size(); ++i) {
     const Eigen::Vector3d& x = data.landmarks[i];
     text += fmt::format("{},{},{},{}\n", i, Num(x.x()), Num(x.y()), Num(x.z()));
   }
-  staged.Write(std::string(kDataFiles[1]), text);
+  staged.Write(std::string(kQuadrotorDataFiles[1]), text);
   text = "t,landmark,u,v\n";
   for (const PixelObservation& m : data.pixels) {
     text += fmt::format("{},{},{},{}\n", Num(m.t), m.landmark, Num(m.uv.x()), Num(m.uv.y()));
   }
-  staged.Write(std::string(kDataFiles[2]), text);
+  staged.Write(std::string(kQuadrotorDataFiles[2]), text);
   text = "t,px,py,pz,qw,qx,qy,qz\n";
   for (const PoseSample& s : data.initial) {
     text += fmt::format("{},{},{},{},{},{},{},{}\n", Num(s.t), Num(s.p.x()), Num(s.p.y()), Num(s.p.z()), Num(s.q.w()),
                         Num(s.q.x()), Num(s.q.y()), Num(s.q.z()));
   }
-  staged.Write(std::string(kDataFiles[3]), text);
-  if (!data.truth.empty()) staged.Write(std::string(kDataFiles[4]), QuadrotorStatesCsv(data.truth));
+  staged.Write(std::string(kQuadrotorDataFiles[3]), text);
+  if (!data.truth.empty()) staged.Write(std::string(kQuadrotorDataFiles[4]), QuadrotorStatesCsv(data.truth));
   staged.Publish(IsDataFolder(folder) ? FolderExisting::kReplace : FolderExisting::kRefuse);
 }
 

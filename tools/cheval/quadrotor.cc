@@ -115,7 +115,7 @@ void RegisterEstimate(CLI::App& app, Action* action) {
       if (has_scenario == has_data) throw UsageError("give exactly one of --scenario NAME or --data DIR");
       std::vector<std::string> inputs{flags->vehicle};
       if (has_data) {
-        for (const char* name : {"vehicle.json", "landmarks.csv", "measurements.csv", "initial.csv", "truth.csv"}) {
+        for (const std::string_view name : estim::kQuadrotorDataFiles) {
           inputs.push_back((std::filesystem::path(flags->data) / name).string());
         }
       }

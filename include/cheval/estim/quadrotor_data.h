@@ -7,13 +7,19 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cheval/estim/quadrotor_estimator.h"
 #include "cheval/estim/vehicle.h"
 
 namespace cheval::estim {
+
+/// The files of a data folder, in the order WriteQuadrotorData writes them (truth.csv is optional).
+inline constexpr std::array<std::string_view, 5> kQuadrotorDataFiles = {"vehicle.json", "landmarks.csv",
+                                                                     "measurements.csv", "initial.csv", "truth.csv"};
 
 /// The state of the vehicle at one time, as truth.csv holds it: the exact state in a simulated
 /// folder, an estimate's state when EstimatedStates (quadrotor_scoring.h) converts one.
