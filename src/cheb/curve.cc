@@ -2,6 +2,7 @@
 
 #include "conditioning.h"
 #include "end_caps.h"
+#include "jumps.h"
 
 #include <algorithm>
 #include <array>
@@ -21,6 +22,18 @@ namespace {
 // The relative tolerance below which coefficients are rounding, not signal: the chop's floor when
 // the data are noise-free.
 constexpr double kRoundingTolerance = 1e-13;
+// A window's residual is consistent with the noise while its lack-of-fit score (a standard normal
+// score of χ²) stays below this: a false alarm per coordinate and window has probability 0.13 %
+// (a split that costs little), while at 4 small unresolved motion (a tremor of twice the noise)
+// passes in short windows (docs/decisions.md).
+constexpr double kLackOfFitLimit = 3.0;
+// The residual is tested against the noise σ times this: σ is an estimate and the noise of real
+// data (and of rotation charts, J_r⁻¹ stretched) varies by some per cent, which in a window of
+// hundreds of samples a χ² test alone would take for unresolved motion (it made the drone's body
+// rate 2–3x worse); a residual of 1.5σ (a missed tremor) still fails.
+constexpr double kNoiseMargin = 1.1;
+// End windows are halved (RefineEnds) while they keep this many samples on each side.
+constexpr Eigen::Index kMinEndWindowSamples = 24;
 using internal::kMaxGramCondition;
 
 // Fits one window and, for automatic degrees, says whether it should be split instead.
@@ -65,6 +78,8 @@ class WindowFitter {
       std::fill(window.degrees.begin(), window.degrees.end(), options_.fixed_degree);
       window.series = FitLeastSquares(tw, zw, options_.fixed_degree, interval);
       window.coefficient_magnitudes = window.series.coefficients.cwiseAbs();
+      LackOfFit(tw, zw, WindowSigma(tw, zw, false), &window);
+      window.verdict = WindowVerdict::kFixedDegree;
       Finish(&window);
       return window;
     }
@@ -125,16 +140,110 @@ class WindowFitter {
     if (cross_validate && (resolved || !may_split)) window.degrees = CrossValidatedDegrees(*folds, top);
     if (!resolved && may_split) return std::nullopt;
 
-    // Each coordinate at its own degree: leading blocks of the same factorisation.
-    const int degree = *std::max_element(window.degrees.begin(), window.degrees.end());
+    // The residual must be consistent with the noise too: a series can look resolved while the
+    // motion it misses lies above the top degree the window may use. A coordinate whose residual
+    // fails at the chosen degree takes the lowest degree of the grid that passes, if any.
     window.series.interval = interval;
-    window.series.coefficients = Eigen::MatrixXd::Zero(degree + 1, d);
-    for (int c = 0; c < d; ++c) {
-      window.series.coefficients.col(c).head(window.degrees[c] + 1) =
-          cholesky->Solve(window.degrees[c], probe.rhs.col(c));
+    SetDegrees(*cholesky, probe, &window);
+    const Eigen::VectorXd sigma = WindowSigma(tw, zw, false);
+    bool consistent = LackOfFit(tw, zw, sigma, &window) || !options_.lack_of_fit;
+    if (!consistent) {
+      const Centred centred = Centre(probe, zw);
+      bool raised = false;
+      for (int c = 0; c < d; ++c) {
+        if (window.lack_of_fit[c] <= kLackOfFitLimit) continue;
+        for (const int degree : DegreeGrid(top)) {
+          if (degree <= window.degrees[c]) continue;
+          if (centred.LackOfFit(*cholesky, degree, c, m, sigma[c]) <= kLackOfFitLimit || degree == top) {
+            window.degrees[c] = degree;
+            raised = true;
+            break;
+          }
+        }
+      }
+      if (raised) {
+        SetDegrees(*cholesky, probe, &window);
+        consistent = LackOfFit(tw, zw, sigma, &window);
+      }
     }
+    if (!consistent && may_split) return std::nullopt;
+    window.verdict = resolved && consistent ? WindowVerdict::kResolved : WindowVerdict::kUnresolved;
     Finish(&window);
     return window;
+  }
+
+  // The noise σ per coordinate a window's residual is tested against: the data's, floored at a
+  // rounding level of the values (1e-9 of their magnitude) so that exact data do not ask for an
+  // exact fit. With `local`, the larger of that and the window's own estimate (the same
+  // divided-difference estimate on its samples: noise may be larger in places). The lack-of-fit
+  // test uses the data's alone: a short window's own estimate scatters by tens of per cent, and
+  // taking the larger would let small unresolved motion pass as noise.
+  Eigen::VectorXd WindowSigma(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
+                              bool local) const {
+    const Eigen::VectorXd own = local ? EstimateNoiseSigma(t, z) : Eigen::VectorXd::Zero(z.cols());
+    Eigen::VectorXd sigma(z.cols());
+    for (Eigen::Index c = 0; c < z.cols(); ++c) {
+      sigma[c] = std::max({sigma_[c], own[c], 1e-9 * (1.0 + z.col(c).cwiseAbs().maxCoeff())});
+    }
+    return sigma;
+  }
+
+  // Standard normal score of RSS/σ² against χ² with `dof` degrees of freedom (Wilson–Hilferty:
+  // (X/ν)^(1/3) is nearly normal with mean 1 − 2/(9ν) and variance 2/(9ν)); 0 without freedom.
+  static double LackOfFitScore(double rss, double sigma, Eigen::Index dof) {
+    if (dof <= 0) return 0.0;
+    sigma *= kNoiseMargin;
+    const double nu = static_cast<double>(dof), v = 2.0 / (9.0 * nu);
+    return (std::cbrt(rss / (sigma * sigma) / nu) - (1.0 - v)) / std::sqrt(v);
+  }
+
+  // Residuals of a window's series at its samples: fills residual_rms and lack_of_fit; whether
+  // every coordinate passes.
+  bool LackOfFit(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
+                 const Eigen::VectorXd& sigma, CurveWindow* window) const {
+    const Eigen::Index m = t.size(), d = z.cols();
+    Eigen::VectorXd x(m);
+    for (Eigen::Index i = 0; i < m; ++i) x[i] = window->series.interval.ToUnit(t[i]);
+    const Eigen::MatrixXd residual = z - EvaluateSeries(window->series.coefficients, x);
+    window->residual_rms.resize(d);
+    window->lack_of_fit.resize(d);
+    bool passes = true;
+    for (Eigen::Index c = 0; c < d; ++c) {
+      const double rss = residual.col(c).squaredNorm();
+      window->residual_rms[c] = std::sqrt(rss / static_cast<double>(m));
+      window->lack_of_fit[c] = LackOfFitScore(rss, sigma[c], m - window->degrees[c] - 1);
+      passes = passes && window->lack_of_fit[c] <= kLackOfFitLimit;
+    }
+    return passes;
+  }
+
+  // The window's series at its per-coordinate degrees: leading blocks of one factorisation.
+  static void SetDegrees(const NestedCholesky& cholesky, const NormalEquations& probe, CurveWindow* window) {
+    const int degree = *std::max_element(window->degrees.begin(), window->degrees.end());
+    const auto d = static_cast<int>(window->degrees.size());
+    window->series.coefficients = Eigen::MatrixXd::Zero(degree + 1, d);
+    for (int c = 0; c < d; ++c) {
+      window->series.coefficients.col(c).head(window->degrees[c] + 1) =
+          cholesky.Solve(window->degrees[c], probe.rhs.col(c));
+    }
+  }
+
+  // The normal equations of the samples about their mean, whose residual sum of squares at any
+  // degree is Σ(z − z̄)² − cᵀb without touching the samples (cancellation limits it to residuals
+  // well above 1e-8 of the spread: used to search, the chosen degree is checked on the samples).
+  struct Centred {
+    Eigen::MatrixXd rhs;
+    Eigen::RowVectorXd squares;
+    double LackOfFit(const NestedCholesky& cholesky, int degree, Eigen::Index c, Eigen::Index m, double sigma) const {
+      const Eigen::VectorXd coefficients = cholesky.Solve(degree, rhs.col(c));
+      const double rss = std::max(0.0, squares[c] - coefficients.dot(rhs.col(c).head(degree + 1)));
+      return LackOfFitScore(rss, sigma, m - degree - 1);
+    }
+  };
+  static Centred Centre(const NormalEquations& probe, const Eigen::Ref<const Eigen::MatrixXd>& z) {
+    const Eigen::RowVectorXd mean = z.colwise().mean();
+    // Σ T_k(x_i)(z_i − z̄) = b_k − z̄·Σ T_k(x_i), and Σ T_k(x_i) is column 0 of the normal matrix.
+    return {probe.rhs - probe.gram.col(0) * mean, (z.rowwise() - mean).colwise().squaredNorm()};
   }
 
   // Whether the top third of a probe's coefficients ((top + 1) x d) is consistent with white noise
@@ -342,16 +451,16 @@ std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::Ve
         std::upper_bound(t.data(), t.data() + t.size(), b) - std::lower_bound(t.data(), t.data() + t.size(), a);
     const bool may_split = inside >= 2 * options.min_window_samples;
     std::optional<CurveWindow> window = fitter.Fit(a, b, segment.begin, segment.end, may_split);
-    if (window) {
-      windows.push_back(std::move(*window));
-      if (options.progress) {  // the samples up to this window's end are fitted (windows come in time order)
-        const auto done = std::upper_bound(t.data(), t.data() + t.size(), b) - t.data();
-        options.progress("fitting windows", done, t.size());
-      }
-    } else {
+    if (!window) {
       const double middle = 0.5 * (a + b);
       stack.emplace_back(middle, b);  // the left half is popped first: windows stay in time order
       stack.emplace_back(a, middle);
+      continue;
+    }
+    windows.push_back(std::move(*window));
+    if (options.progress) {  // the samples up to this window's end are fitted (windows come in time order)
+      const auto done = std::upper_bound(t.data(), t.data() + t.size(), b) - t.data();
+      options.progress("fitting windows", done, t.size());
     }
   }
   return windows;
@@ -372,7 +481,7 @@ void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegme
       auto& windows = segment.windows;
       const CurveWindow& end = front ? windows.front() : windows.back();
       if (max_degree(end) <= options.end_degree ||
-          samples_in(end.core_begin, end.core_end) < 2 * options.min_window_samples) {
+          samples_in(end.core_begin, end.core_end) < 2 * std::max<Eigen::Index>(options.min_window_samples, kMinEndWindowSamples)) {
         break;
       }
       const double a = end.core_begin, b = end.core_end, middle = 0.5 * (a + b);
@@ -476,18 +585,73 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   }
   std::nth_element(dts.begin(), dts.begin() + static_cast<std::ptrdiff_t>(dts.size() / 2), dts.end());
   const double gap = std::max(options.gap_factor * dts[dts.size() / 2], options.min_gap_s);
+  // Boundaries b (between sorted samples b and b + 1) where the data are split.
+  std::vector<Eigen::Index> gaps;
+  for (Eigen::Index i = 1; i < m; ++i) {
+    if (t[i] - t[i - 1] > gap) gaps.push_back(i - 1);
+  }
+
+  // Jumps and glitches (CurveOptions::robust): outliers leave the fit, jumps split it.
+  internal::Jumps jumps;
+  if (options.robust) {
+    const Eigen::VectorXd noise = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
+                                                      : EstimateNoiseSigma(t, z, gaps);
+    jumps = internal::FindJumps(t, z, gaps, noise);
+  }
+  std::vector<char> kept(static_cast<size_t>(m), 1);
+  for (const Eigen::Index i : jumps.outliers) {
+    kept[static_cast<size_t>(i)] = 0;
+    curve.outlier_times_.push_back(t[i]);
+  }
+  for (const Eigen::Index b : jumps.breaks) curve.jump_times_.push_back(0.5 * (t[b] + t[b + 1]));
+  // The samples fitted, and the boundaries in their numbering (a boundary after sample b becomes
+  // one after the last kept sample up to b).
+  std::vector<Eigen::Index> fitted_index(static_cast<size_t>(m));
+  Eigen::Index fitted_count = 0;
+  for (Eigen::Index i = 0; i < m; ++i) {
+    fitted_index[static_cast<size_t>(i)] = fitted_count;
+    fitted_count += kept[static_cast<size_t>(i)];
+  }
+  if (fitted_count < m) {
+    Eigen::VectorXd ft(fitted_count);
+    Eigen::MatrixXd fz(fitted_count, z.cols());
+    for (Eigen::Index i = 0, k = 0; i < m; ++i) {
+      if (!kept[static_cast<size_t>(i)]) continue;
+      ft[k] = t[i];
+      fz.row(k++) = z.row(i);
+    }
+    t = std::move(ft);
+    z = std::move(fz);
+  }
+  // (boundary, is a jump) in the fitted numbering, ascending.
+  std::vector<std::pair<Eigen::Index, bool>> boundaries;
+  auto add_boundary = [&](Eigen::Index b, bool jump) {
+    const Eigen::Index last_kept = fitted_index[static_cast<size_t>(b)] + kept[static_cast<size_t>(b)] - 1;
+    if (last_kept >= 0 && last_kept + 1 < fitted_count) boundaries.emplace_back(last_kept, jump);
+  };
+  for (const Eigen::Index b : gaps) add_boundary(b, false);
+  for (const Eigen::Index b : jumps.breaks) add_boundary(b, true);
+  std::sort(boundaries.begin(), boundaries.end());
+  boundaries.erase(std::unique(boundaries.begin(), boundaries.end(),
+                               [](const auto& x, const auto& y) { return x.first == y.first; }),
+                   boundaries.end());
+  std::vector<Eigen::Index> cuts;
+  for (const auto& [b, jump] : boundaries) cuts.push_back(b);
 
   curve.noise_sigma_ = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
-                                           : EstimateNoiseSigma(z);
+                                           : EstimateNoiseSigma(t, z, cuts);
   const WindowFitter fitter(t, z, curve.noise_sigma_, options);
 
-  // Segment boundaries [starts[k], starts[k+1]); a segment with one distinct stamp joins the
-  // neighbour across the shorter gap.
+  // Segment boundaries [starts[k], starts[k+1]), with whether each segment ends at a jump; a
+  // segment with one distinct stamp joins the neighbour across the shorter gap.
   std::vector<Eigen::Index> starts{0};
-  for (Eigen::Index i = 1; i < m; ++i) {
-    if (t[i] - t[i - 1] > gap) starts.push_back(i);
+  std::vector<char> at_jump;
+  for (const auto& [b, jump] : boundaries) {
+    starts.push_back(b + 1);
+    at_jump.push_back(jump ? 1 : 0);
   }
-  starts.push_back(m);
+  starts.push_back(fitted_count);
+  at_jump.push_back(0);
   for (size_t k = 0; k + 1 < starts.size() && starts.size() > 2;) {
     if (t[starts[k + 1] - 1] != t[starts[k]]) {
       ++k;
@@ -496,15 +660,19 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     const double left_gap = k > 0 ? t[starts[k]] - t[starts[k] - 1] : std::numeric_limits<double>::infinity();
     const double right_gap = k + 2 < starts.size() ? t[starts[k + 1]] - t[starts[k + 1] - 1]
                                                    : std::numeric_limits<double>::infinity();
-    starts.erase(starts.begin() + static_cast<std::ptrdiff_t>(left_gap <= right_gap ? k : k + 1));
+    const size_t removed = left_gap <= right_gap ? k : k + 1;
+    // The boundary before starts[removed] goes: the joined segment ends where the later one did.
+    at_jump.erase(at_jump.begin() + static_cast<std::ptrdiff_t>(removed - 1));
+    starts.erase(starts.begin() + static_cast<std::ptrdiff_t>(removed));
     if (k > 0) --k;
   }
 
-  ReportProgress(options.progress, "fitting windows", 0, m);
+  ReportProgress(options.progress, "fitting windows", 0, fitted_count);
   for (size_t k = 0; k + 1 < starts.size(); ++k) {
     CurveSegment segment;
     segment.begin = t[starts[k]];
     segment.end = t[starts[k + 1] - 1];
+    segment.continues = at_jump[k] != 0;
     if (options.single_window || options.window_s) {
       const int cores = options.single_window
                             ? 1
@@ -523,8 +691,11 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
 
   if (options.end_caps && !options.single_window && !options.window_s &&
       options.degree_method != DegreeMethod::kFixed) {
-    std::vector<int64_t> sorted(static_cast<size_t>(m));
-    for (Eigen::Index i = 0; i < m; ++i) sorted[static_cast<size_t>(i)] = stamps_ns[order[i]];
+    std::vector<int64_t> sorted;
+    sorted.reserve(static_cast<size_t>(fitted_count));
+    for (Eigen::Index i = 0; i < m; ++i) {
+      if (kept[static_cast<size_t>(i)]) sorted.push_back(stamps_ns[order[i]]);
+    }
     // A segment's caps are chosen before they are inserted, and evaluating one segment's samples
     // uses only its own windows.
     const internal::VelocityAt velocity = [&](Eigen::Index first, Eigen::Index count) {
@@ -538,12 +709,15 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     }
   }
 
-  ReportProgress(options.progress, "fitting windows", m, m);
-  // Residuals at every sample.
+  ReportProgress(options.progress, "fitting windows", fitted_count, fitted_count);
+  // Residuals at every sample fitted.
   Eigen::MatrixXd fitted;
   curve.EvaluateMany(stamps_ns, 0, &fitted);
-  const Eigen::VectorXd squares = (fitted - values).colwise().squaredNorm().transpose();
-  curve.residual_rms_ = (squares / static_cast<double>(m)).cwiseSqrt();
+  Eigen::VectorXd squares = Eigen::VectorXd::Zero(values.cols());
+  for (Eigen::Index i = 0; i < m; ++i) {
+    if (kept[static_cast<size_t>(i)]) squares += (fitted.row(order[i]) - values.row(order[i])).cwiseAbs2().transpose();
+  }
+  curve.residual_rms_ = (squares / static_cast<double>(fitted_count)).cwiseSqrt();
   return curve;
 }
 
@@ -568,6 +742,13 @@ Curve::Placement Curve::Locate(double t, double tolerance_s) const {
     if (t >= s.begin - tolerance_s && t <= s.end + tolerance_s) {
       segment = &s;
       break;
+    }
+  }
+  if (segment == nullptr) {
+    // Between two segments split at a jump: the nearer one.
+    for (size_t k = 0; k + 1 < segments_.size() && segment == nullptr; ++k) {
+      const CurveSegment &left = segments_[k], &right = segments_[k + 1];
+      if (left.continues && t > left.end && t < right.begin) segment = t - left.end <= right.begin - t ? &left : &right;
     }
   }
   if (segment == nullptr) {
@@ -718,6 +899,14 @@ Curve Curve::FromParts(int64_t origin_ns, std::vector<CurveSegment> segments, Ei
   curve.noise_sigma_ = std::move(noise_sigma);
   curve.residual_rms_ = std::move(residual_rms);
   return curve;
+}
+
+Eigen::Index Curve::unresolved_windows() const {
+  Eigen::Index count = 0;
+  for (const CurveSegment& s : segments_) {
+    for (const CurveWindow& w : s.windows) count += w.verdict == WindowVerdict::kUnresolved ? 1 : 0;
+  }
+  return count;
 }
 
 Eigen::Index Curve::stored_values() const {

@@ -1,6 +1,7 @@
 #include "cheval/cheb/degree.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -70,6 +71,49 @@ Eigen::VectorXd EstimateNoiseSigma(const Eigen::Ref<const Eigen::MatrixXd>& z, i
     auto middle = magnitudes.begin() + static_cast<std::ptrdiff_t>(magnitudes.size() / 2);
     std::nth_element(magnitudes.begin(), middle, magnitudes.end());
     sigma[c] = 1.4826 * *middle / std::sqrt(gain);
+  }
+  return sigma;
+}
+
+Eigen::VectorXd EstimateNoiseSigma(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
+                                   const std::vector<Eigen::Index>& breaks) {
+  constexpr int kRun = 5;  // 4th divided differences
+  const Eigen::Index m = z.rows(), d = z.cols();
+  std::vector<char> cut(static_cast<size_t>(std::max<Eigen::Index>(m, 1)), 0);
+  for (const Eigen::Index b : breaks) {
+    if (b >= 0 && b < m) cut[static_cast<size_t>(b)] = 1;
+  }
+  std::vector<std::vector<double>> magnitudes(static_cast<size_t>(d));
+  for (Eigen::Index i = 0; i + kRun <= m; ++i) {
+    bool usable = true;
+    for (Eigen::Index j = i; j + 1 < i + kRun && usable; ++j) usable = !cut[static_cast<size_t>(j)] && t[j + 1] > t[j];
+    if (!usable) continue;
+    // Weights in a unit time scale (the run's span): only their ratio to their norm matters.
+    const double span = t[i + kRun - 1] - t[i];
+    std::array<double, kRun> w{};
+    double norm = 0.0;
+    for (int j = 0; j < kRun; ++j) {
+      double product = 1.0;
+      for (int k = 0; k < kRun; ++k) {
+        if (k != j) product *= (t[i + j] - t[i + k]) / span;
+      }
+      w[j] = 1.0 / product;
+      norm += w[j] * w[j];
+    }
+    norm = std::sqrt(norm);
+    for (Eigen::Index c = 0; c < d; ++c) {
+      double sum = 0.0;
+      for (int j = 1; j < kRun; ++j) sum += w[j] * (z(i + j, c) - z(i, c));  // Σ w_j = 0
+      magnitudes[static_cast<size_t>(c)].push_back(std::abs(sum) / norm);
+    }
+  }
+  Eigen::VectorXd sigma = Eigen::VectorXd::Zero(d);
+  for (Eigen::Index c = 0; c < d; ++c) {
+    std::vector<double>& values = magnitudes[static_cast<size_t>(c)];
+    if (values.empty()) continue;
+    auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    sigma[c] = 1.4826 * *middle;
   }
   return sigma;
 }

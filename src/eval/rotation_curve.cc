@@ -17,6 +17,10 @@ using SO3 = lie::SO3<double>;
 // A chart never holds rotations further than this from its origin, whatever the sample count:
 // Log is smooth up to π and J_r is well conditioned well before it.
 constexpr double kMaxChartAngle = 2.5;
+// A chart piece holds at least this many samples where kMaxChartAngle allows, and neighbours
+// overlap by a quarter of it: enough for each to be fitted on its own and for a smooth blend (fewer
+// made the drone's body rate 1.3–2x worse, docs/decisions.md).
+constexpr Eigen::Index kMinPieceSamples = 24;
 
 double Angle(const SO3& a, const SO3& b) { return (a.Inverse() * b).Log().norm(); }
 
@@ -96,16 +100,21 @@ RotationCurve FitRotationCurve(std::span<const int64_t> stamps_ns, std::span<con
     sorted[i] = SO3(q);
   }
 
+  // Chart noise is the rotation noise stretched by J_r⁻¹(φ), which varies across a chart: windows
+  // shorter than a piece's minimum would follow it (12-sample windows made the drone's and the
+  // handheld's body rate 15–25 % worse).
+  cheb::CurveOptions chart_options = options.curve;
+  chart_options.min_window_samples = std::max<int>(chart_options.min_window_samples, kMinPieceSamples);
   RotationCurve curve;
   curve.origin_ns_ = stamps.front();
-  for (const Piece& piece : CutPieces(stamps, sorted, options.max_chart_angle, options.curve.min_window_samples)) {
+  for (const Piece& piece : CutPieces(stamps, sorted, options.max_chart_angle, kMinPieceSamples)) {
     const Eigen::Index n = piece.end - piece.begin;
     Eigen::MatrixXd chart(n, 3);
     const SO3 inverse = piece.origin.Inverse();
     for (Eigen::Index i = 0; i < n; ++i) chart.row(i) = (inverse * sorted[piece.begin + i]).Log().transpose();
     const std::span<const int64_t> piece_stamps(stamps.data() + piece.begin, static_cast<size_t>(n));
     curve.charts_.push_back({piece.origin.quaternion(), piece_stamps.front(), piece_stamps.back(),
-                             cheb::FitCurve(piece_stamps, chart, options.curve)});
+                             cheb::FitCurve(piece_stamps, chart, chart_options)});
   }
 
   std::vector<Eigen::Quaterniond> fitted;

@@ -247,6 +247,38 @@ traj::Trajectory VelocityTrajectory(const traj::TrajectoryView& input, const Vel
   return out;
 }
 
+namespace {
+
+const char* VerdictName(cheb::WindowVerdict verdict) {
+  switch (verdict) {
+    case cheb::WindowVerdict::kResolved: return "resolved";
+    case cheb::WindowVerdict::kUnresolved: return "unresolved";
+    case cheb::WindowVerdict::kFixedDegree: return "fixed_degree";
+  }
+  return "unknown";
+}
+
+}  // namespace
+
+std::string UnresolvedWarning(const cheb::Curve& curve) {
+  const cheb::CurveWindow* worst = nullptr;
+  double worst_ratio = 0.0;
+  for (const cheb::CurveSegment& segment : curve.segments()) {
+    for (const cheb::CurveWindow& w : segment.windows) {
+      if (w.verdict != cheb::WindowVerdict::kUnresolved || w.residual_rms.size() != curve.dimension()) continue;
+      for (Eigen::Index c = 0; c < w.residual_rms.size(); ++c) {
+        const double ratio = curve.noise_sigma()[c] > 0.0 ? w.residual_rms[c] / curve.noise_sigma()[c] : 0.0;
+        if (worst == nullptr || ratio > worst_ratio) worst = &w, worst_ratio = ratio;
+      }
+    }
+  }
+  if (worst == nullptr) return {};
+  return fmt::format(
+      "{} window(s) still fail the residual test at the smallest window; the worst, {:.3f}..{:.3f} s from the first "
+      "sample, has a residual {:.1f}x the noise: its velocity may miss motion there (--json lists them)",
+      curve.unresolved_windows(), worst->fit_begin, worst->fit_end, worst_ratio);
+}
+
 std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimate) {
   nlohmann::json j;  // keys sorted, as the file has always been written
   j["command"] = "velocity";
@@ -259,8 +291,13 @@ std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimat
     std::vector<int> degrees;
     for (const cheb::CurveSegment& segment : curve.segments()) {
       for (const cheb::CurveWindow& w : segment.windows) {
-        windows.push_back(
-            {{"begin_s", w.fit_begin}, {"end_s", w.fit_end}, {"samples", w.samples}, {"degrees", w.degrees}});
+        nlohmann::json window = {{"begin_s", w.fit_begin}, {"end_s", w.fit_end}, {"samples", w.samples},
+                                 {"degrees", w.degrees}, {"accepted", VerdictName(w.verdict)}};
+        if (w.residual_rms.size() == curve.dimension()) {  // end caps are chosen otherwise (docs/velocity.md)
+          window["residual_rms_m"] = std::vector<double>(w.residual_rms.data(), w.residual_rms.data() + w.residual_rms.size());
+          window["lack_of_fit"] = std::vector<double>(w.lack_of_fit.data(), w.lack_of_fit.data() + w.lack_of_fit.size());
+        }
+        windows.push_back(std::move(window));
         degrees.insert(degrees.end(), w.degrees.begin(), w.degrees.end());
       }
     }
@@ -272,6 +309,9 @@ std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimat
     j["noise_sigma_m"] = std::vector<double>(curve.noise_sigma().data(), curve.noise_sigma().data() + 3);
     j["residual_rmse_m"] = std::vector<double>(curve.residual_rms().data(), curve.residual_rms().data() + 3);
     j["compression_ratio"] = static_cast<double>(3 * run.input_poses) / static_cast<double>(curve.stored_values());
+    j["unresolved_windows"] = curve.unresolved_windows();
+    j["outliers"] = curve.outlier_times().size();
+    j["jumps"] = curve.jump_times().size();
   }
   if (estimate.rotation_curve) {
     j["angular"] = {{"charts", estimate.rotation_curve->charts().size()},

@@ -18,8 +18,18 @@ namespace cheval::cheb {
 /// Options of Compress; Validate() is called by Compress.
 struct CompressOptions {
   /// The automatic fit (FitCurve) and the limits of the tolerance fit (max_conditioning,
-  /// max_degree, min_window_samples, overlap); the defaults need no tuning.
-  CurveOptions curve;
+  /// max_degree, min_window_samples, overlap); the defaults need no tuning. A model represents
+  /// every sample: no sample is left out as an outlier, windows are judged by their coefficients
+  /// (the residual test would store more than the samples of nearly noise-free ground truth), and
+  /// they stop at 24 samples (velocity's 12 serve its σ → 0 limit).
+  CurveOptions curve = CompressionCurveOptions();
+  static CurveOptions CompressionCurveOptions() {
+    CurveOptions options;
+    options.robust = false;
+    options.lack_of_fit = false;
+    options.min_window_samples = 24;
+    return options;
+  }
   /// The largest reconstruction error accepted (units of the samples: metres for positions): the
   /// Euclidean norm of (model - sample) at every sample must not exceed it. It is a budget the
   /// model spends: the result is the smallest model found within it, coarser than the automatic

@@ -40,8 +40,10 @@ struct CurveOptions {
   double max_conditioning = 8.0;
   /// Largest degree tried in a window.
   int max_degree = 400;
-  /// Windows are not split below this many samples.
-  int min_window_samples = 24;
+  /// Windows are not split below this many samples: with the lack-of-fit test, nearly noise-free
+  /// data with fine motion end in short windows at a high relative degree (the σ → 0 limit, a
+  /// local interpolant); noisy fits rarely come near it (docs/velocity.md).
+  int min_window_samples = 12;
   /// Each window extends beyond its core by this fraction of the core on both sides.
   double overlap = 0.25;
   /// A stamp difference larger than both gap_factor x the median difference and min_gap_s splits
@@ -66,6 +68,17 @@ struct CurveOptions {
   bool end_caps = true;
   /// Fit a single window over each gap-free segment (no splitting), e.g. to reproduce a global fit.
   bool single_window = false;
+  /// Find isolated defects before fitting (docs/velocity.md, "Jumps and glitches"): a sample
+  /// displaced from both of its neighbours is left out of the fit (an outlier), and a jump of the
+  /// values or of their rate between two samples splits the data there as a gap does, so that
+  /// neither spreads over a window. Only departures far beyond the local scatter count (6 local
+  /// scales): on clean data next to nothing is found. false fits every sample as given.
+  bool robust = true;
+  /// A window is accepted only when its residual is consistent with the noise too (the
+  /// lack-of-fit test, docs/velocity.md), not only its coefficients: otherwise it is split, down to
+  /// min_window_samples. false judges by the coefficients alone (compression does: on nearly
+  /// noise-free ground truth the residual test asks for windows that store more than the samples).
+  bool lack_of_fit = true;
   /// Told "fitting windows" with the samples fitted so far, as windows are accepted (may be empty).
   ProgressFn progress;
 
@@ -74,6 +87,18 @@ struct CurveOptions {
   /// min_window_samples < 2, overlap outside [0, 1], gap_factor <= 1, min_gap_s < 0, noise_sigma
   /// negative or not finite, end_degree < 0.
   void Validate() const;
+};
+
+/// Why a window was accepted.
+enum class WindowVerdict {
+  /// Its series reached the noise plateau (standardChop or a noise-like tail) and its residual is
+  /// consistent with the noise (the lack-of-fit test, docs/velocity.md).
+  kResolved,
+  /// It fails one of those tests but could not be split further (too few samples, or a literal
+  /// fit: window_s, single_window, end windows): its velocity may miss motion there.
+  kUnresolved,
+  /// A fixed degree was asked for: nothing was tested for acceptance.
+  kFixedDegree,
 };
 
 /// One window: its core [core_begin, core_end] (seconds from the curve's origin), the samples used
@@ -89,12 +114,22 @@ struct CurveWindow {
   Eigen::MatrixXd first_derivative, second_derivative;
   /// |c_k| per coordinate of the high-degree fit the degree was chosen from (diagnostics), (K x d).
   Eigen::MatrixXd coefficient_magnitudes;
+  /// Root mean square of the residuals of the window's samples, per coordinate (diagnostics).
+  Eigen::VectorXd residual_rms;
+  /// The lack-of-fit statistic per coordinate: the residual sum of squares over σ² is χ² with
+  /// m − N − 1 degrees of freedom for a fit that has resolved the motion; this is its standard
+  /// normal score (Wilson–Hilferty), accepted up to 3 (diagnostics).
+  Eigen::VectorXd lack_of_fit;
+  WindowVerdict verdict = WindowVerdict::kResolved;
 };
 
 /// A gap-free stretch of data with its windows, ordered in time.
 struct CurveSegment {
   double begin = 0, end = 0;  ///< first and last sample time (s from origin)
   std::vector<CurveWindow> windows;
+  /// The next segment follows without a gap: the data were split at a jump (CurveOptions::robust),
+  /// and a time between the two segments belongs to the nearer one.
+  bool continues = false;
 };
 
 /// The fitted curve.
@@ -129,10 +164,16 @@ class Curve {
   const std::vector<CurveSegment>& segments() const { return segments_; }
   /// The noise σ per coordinate used to choose degrees (estimated or given).
   const Eigen::VectorXd& noise_sigma() const { return noise_sigma_; }
-  /// Root mean square of the fit residuals over all samples (per coordinate).
+  /// Root mean square of the fit residuals over the samples fitted (outliers left out), per coordinate.
   const Eigen::VectorXd& residual_rms() const { return residual_rms_; }
   /// Total number of stored values (Σ over windows of (degree + 1) per coordinate).
   Eigen::Index stored_values() const;
+  /// Times (s from the origin) of the samples left out as outliers, and of the jumps the data were
+  /// split at (midway between the two samples), CurveOptions::robust.
+  const std::vector<double>& outlier_times() const { return outlier_times_; }
+  const std::vector<double>& jump_times() const { return jump_times_; }
+  /// The windows that were accepted unresolved (WindowVerdict::kUnresolved).
+  Eigen::Index unresolved_windows() const;
 
  private:
   // Where a time falls: its window, and when it is in a blending zone the next window with the
@@ -152,6 +193,7 @@ class Curve {
   std::vector<CurveSegment> segments_;
   Eigen::VectorXd noise_sigma_;
   Eigen::VectorXd residual_rms_;
+  std::vector<double> outlier_times_, jump_times_;
 };
 
 /// Quintic smoothstep s(u) = 6u⁵ − 15u⁴ + 10u³ on u clamped to [0, 1], with ds/du and d²s/du²:

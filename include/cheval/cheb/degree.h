@@ -3,6 +3,8 @@
 /// Choosing the degree of a least-squares Chebyshev fit automatically, and estimating the noise
 /// level of the samples that sets the threshold.
 
+#include <vector>
+
 #include <Eigen/Core>
 
 namespace cheval::cheb {
@@ -20,5 +22,16 @@ int StandardChop(const Eigen::Ref<const Eigen::VectorXd>& coefficients, double t
 /// difference (× 1.4826). `z` is m x d (each column a coordinate); returns one σ per column.
 /// Returns zeros when m <= k.
 Eigen::VectorXd EstimateNoiseSigma(const Eigen::Ref<const Eigen::MatrixXd>& z, int order = 4);
+
+/// The same estimate for samples at times `t` (sorted, m), evenly spaced or not: each run of five
+/// consecutive samples gives the 4th divided difference Σ w_j z_j, w_j = 1/Π_{k≠j}(t_j − t_k),
+/// which annihilates cubics whatever the spacing, and Σ w_j z_j / sqrt(Σ w_j²) has standard
+/// deviation σ under white noise. σ̂ = 1.4826 · median of its magnitude. For even spacing this is
+/// exactly the 4th-difference estimate above; with stamp jitter or uneven sampling that one
+/// mistakes the spacing for noise (a velocity v and a jitter δt look like noise v·δt). Runs with
+/// two equal stamps, and runs that cross a boundary in `breaks` (a run may not contain both
+/// samples i and i + 1 for a listed i), are skipped.
+Eigen::VectorXd EstimateNoiseSigma(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
+                                   const std::vector<Eigen::Index>& breaks = {});
 
 }  // namespace cheval::cheb

@@ -32,7 +32,7 @@ struct RotationCurveOptions {
   cheb::CurveOptions curve;
   /// Largest angle (rad) between a chart's origin and the rotations it fits. Small keeps the
   /// charts close to flat; the fit is exact for any value below π. Pieces are extended beyond it
-  /// (up to kMaxChartAngle) only to reach `curve.min_window_samples` samples.
+  /// (up to kMaxChartAngle) only to reach 24 samples, also the charts' smallest window.
   double max_chart_angle = 1.0;
 };
 

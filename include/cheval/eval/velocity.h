@@ -87,6 +87,10 @@ struct VelocityEstimate {
 VelocityEstimate EstimateVelocity(const traj::TrajectoryView& trajectory, const VelocityOptions& options,
                                   std::optional<std::span<const int64_t>> at_ns = std::nullopt);
 
+/// One line saying where a fit still fails its residual test (WindowVerdict::kUnresolved: the
+/// worst window, its residual against the noise), or empty when every window passed.
+std::string UnresolvedWarning(const cheb::Curve& curve);
+
 /// The trajectory of an estimate (what `cheval velocity -o` writes, docs/velocity.md): at the
 /// trajectory's own stamps (`at_ns` nullopt) its positions and orientations as read; at other
 /// stamps the fitted positions and orientations (the fitted orientation curve with `angular`, else

@@ -1,0 +1,28 @@
+#pragma once
+// Isolated defects of sampled motion that no smooth curve should absorb (FitCurve, robust fits):
+// a sample displaced from its neighbours (a glitch), a jump of the positions that persists (a
+// relocalisation of the ground truth), and a jump of the velocity (an impact). Found on the slopes
+// between consecutive samples, d_j = (z_{j+1} − z_j)/(t_{j+1} − t_j), each compared with straight
+// lines fitted to its neighbours on either side; docs/velocity.md, "Jumps and glitches".
+
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace cheval::cheb::internal {
+
+struct Jumps {
+  /// Samples to leave out of the fit (glitches), ascending.
+  std::vector<Eigen::Index> outliers;
+  /// Boundaries b (ascending) where the motion jumps between samples b and b + 1: the fit is split
+  /// there as at a gap.
+  std::vector<Eigen::Index> breaks;
+};
+
+/// t: sorted times (s), z: m x d samples, gaps: boundaries b that are already gaps (not crossed by
+/// the neighbour lines), noise: the samples' noise σ per coordinate (sets the floor of the local
+/// scale). O(m) for a fixed neighbourhood.
+Jumps FindJumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<Eigen::Index>& gaps,
+                const Eigen::VectorXd& noise);
+
+}  // namespace cheval::cheb::internal
