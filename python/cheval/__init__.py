@@ -158,6 +158,7 @@ def fit(source, values=None, *, degree="auto", window=None, noise=None, format="
     samples; default estimated). See cheval.Curve.
     """
     if values is not None:
+        _cheval.check_real(values, "values")
         return _cheval.fit(source, values, degree=degree, window=window, noise=noise)
     return _cheval.fit(_trajectory(source, format, columns, kitti_times), degree=degree, window=window,
                        noise=noise)
@@ -170,6 +171,7 @@ def compress(source, values=None, *, tolerance=None, format="auto", columns=None
     None for the automatic fit. Returns a Compression (.model, .ratio, .max_error, ...).
     """
     if values is not None:
+        _cheval.check_real(values, "values")
         return _cheval.compress(source, values, tolerance=tolerance)
     return _cheval.compress(_trajectory(source, format, columns, kitti_times), tolerance=tolerance)
 

@@ -120,12 +120,28 @@ py::array_t<int64_t> StampsArray(const py::handle& stamps) {
       }
     }
   }
-  return py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(array);
+  auto converted = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(array);
+  // Every difference of two stamps must fit int64, as in a file (traj::StampSpan).
+  traj::StampSpan span;
+  const int64_t* data = converted.data();
+  for (py::ssize_t i = 0; i < converted.size(); ++i) {
+    if (auto problem = span.Add(data[i], i, "row")) {
+      throw InputError("<array>", 0, 0, fmt::format("row {}: {}", i, *problem));
+    }
+  }
+  return converted;
 }
 
 DoubleArray RealArray(const py::handle& values, const char* name) {
   const py::array array = py::array::ensure(values);
   if (!array) throw py::type_error(fmt::format("{}: expected an array of numbers", name));
+  CheckReal(array, name);
+  DoubleArray converted = DoubleArray::ensure(array);
+  if (!converted) throw py::type_error(fmt::format("{}: expected an array of real numbers", name));
+  return converted;
+}
+
+void CheckReal(const py::array& array, const char* name) {
   const char kind = array.dtype().kind();
   if (kind == 'c') {
     throw InputError("<array>", 0, 0,
@@ -137,9 +153,6 @@ DoubleArray RealArray(const py::handle& values, const char* name) {
     throw InputError("<array>", 0, 0,
                      fmt::format("{}: expected real numbers, got dtype {}", name, py::str(array.dtype()).cast<std::string>()));
   }
-  DoubleArray converted = DoubleArray::ensure(array);
-  if (!converted) throw py::type_error(fmt::format("{}: expected an array of real numbers", name));
-  return converted;
 }
 
 }  // namespace cheval::python

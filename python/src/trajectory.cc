@@ -187,6 +187,14 @@ are immutable; the array properties are read-only views of the stored data (no c
           "The trajectory as the text of a file in `format` (tum, tumv, euroc, kitti), as cheval.write writes it.");
 
   m.def(
+      "check_real",
+      [](const py::handle& values, const std::string& name) {
+        const py::array array = py::array::ensure(values);
+        if (array) CheckReal(array, name.c_str());
+      },
+      "Raises InputError for a complex (or text) array `values`, named `name`, as Trajectory() does.");
+
+  m.def(
       "read",
       [](const std::string& path, const std::string& format, const std::string& columns,
          const std::string& kitti_times) {

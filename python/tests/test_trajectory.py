@@ -226,6 +226,9 @@ class ArrayValidationTest(unittest.TestCase):
         self.assertRefused("row 2: time stamp 5000000000.000000000 s is 1e+10 s away from the stamp of row 0 "
                            "(-5000000000.000000000 s); expected the stamps of one trajectory to span at most int64 "
                            "nanoseconds (about 292 years, 9.2e9 s)", stamps=stamps)
+        with self.assertRaises(cheval.InputError) as raised:  # every face that takes stamps
+            cheval.fit(stamps, np.zeros((5, 1)))
+        self.assertIn("row 2: time stamp 5000000000.000000000 s is 1e+10 s away", str(raised.exception))
 
     def test_complex_arrays_are_refused_not_truncated(self):
         arrays = example(n=5)
@@ -235,6 +238,13 @@ class ArrayValidationTest(unittest.TestCase):
                            "conversion would drop the imaginary part)",
                            quaternions=arrays["quaternions"].astype(np.complex64))
         self.assertRefused("velocities: expected real numbers, got dtype <U3", velocities=np.full((5, 3), "1.0"))
+        stamps = np.arange(50, dtype=np.int64) * 10_000_000
+        for function in (cheval.fit, cheval.compress):
+            with self.subTest(function=function.__name__):
+                with self.assertRaises(cheval.InputError) as raised:
+                    function(stamps, np.ones((50, 3)) + 1e-3j)
+                self.assertEqual(str(raised.exception), "<array>:0:0: error: values: complex values (dtype complex128) "
+                                 "are not accepted; expected real numbers (a conversion would drop the imaginary part)")
 
     def test_a_path_with_a_nul_byte_is_refused_not_cut_short(self):
         with tempfile.TemporaryDirectory() as folder:
