@@ -168,7 +168,9 @@ Violation CheckTrajectory(const Trajectory& t, Format format, const ColumnMap* c
   switch (format) {
     case Format::kTum:
     case Format::kTumV:
-      FUZZ_REQUIRE(c == (Channels{OrientationKind::kQuaternion, format == Format::kTumV, false, true}));
+      // tumv: 11 fields, or 14 with the body angular velocity (what `cheval velocity --angular` writes).
+      FUZZ_REQUIRE(c == (Channels{OrientationKind::kQuaternion, format == Format::kTumV,
+                                  format == Format::kTumV && c.angular_velocity, true}));
       break;
     case Format::kEuroc:
     case Format::kVins:
