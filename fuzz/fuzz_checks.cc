@@ -84,6 +84,18 @@ bool SameBits(const std::vector<double>& a, const std::vector<double>& b) {
 
 bool StartsWith(std::string_view text, std::string_view prefix) { return text.substr(0, prefix.size()) == prefix; }
 
+// A message quotes the input's bytes escaped and cut (traj::QuoteField): no control byte reaches the
+// terminal, and no field makes it long, whatever the input.
+Violation CheckMessageQuoting(std::string_view message, const char* call) {
+  const bool control = std::any_of(message.begin(), message.end(), [](char c) {
+    const auto u = static_cast<unsigned char>(c);
+    return u < 0x20 || u == 0x7f;
+  });
+  if (control) return std::string(call) + " threw a message with a raw control byte: " + Printable(message);
+  if (message.size() > 1000) return std::string(call) + " threw a message of " + std::to_string(message.size()) + " bytes";
+  return std::nullopt;
+}
+
 // A documented failure of the reader: an InputError whose message starts with the file's path.
 Violation CheckInputError(const Error& e, const std::string& path, const char* call) {
   if (dynamic_cast<const InputError*>(&e) == nullptr) {
@@ -92,7 +104,7 @@ Violation CheckInputError(const Error& e, const std::string& path, const char* c
   if (!StartsWith(e.what(), path + ":")) {
     return std::string(call) + " threw an InputError whose message does not begin with '" + path + ":': " + e.what();
   }
-  return std::nullopt;
+  return CheckMessageQuoting(e.what(), call);
 }
 
 // Writes `trajectory` in `format` and reads it back with that format; the result must match what was
@@ -146,11 +158,19 @@ Violation CheckTrajectory(const Trajectory& t, Format format, const ColumnMap* c
   FUZZ_REQUIRE(AllFinite(t.raw_orientations()));
   FUZZ_REQUIRE(AllFinite(t.raw_velocities()));
   FUZZ_REQUIRE(AllFinite(t.raw_angular_velocities()));
+  // Every difference of two stamps fits int64 nanoseconds (the readers refuse a wider span).
+  if (n > 0) {
+    const auto [lowest, highest] = std::minmax_element(t.stamps_ns().begin(), t.stamps_ns().end());
+    int64_t span = 0;
+    FUZZ_REQUIRE(!__builtin_sub_overflow(*highest, *lowest, &span));
+  }
 
   switch (format) {
     case Format::kTum:
     case Format::kTumV:
-      FUZZ_REQUIRE(c == (Channels{OrientationKind::kQuaternion, format == Format::kTumV, false, true}));
+      // tumv: 11 fields, or 14 with the body angular velocity (what `cheval velocity --angular` writes).
+      FUZZ_REQUIRE(c == (Channels{OrientationKind::kQuaternion, format == Format::kTumV,
+                                  format == Format::kTumV && c.angular_velocity, true}));
       break;
     case Format::kEuroc:
     case Format::kVins:
@@ -237,7 +257,7 @@ Violation CheckTrajectoryTarget(std::string_view target, std::string_view conten
       options.columns = ColumnMap::Parse(spec);
     } catch (const UsageError& e) {
       FUZZ_REQUIRE(StartsWith(e.what(), "ReadOptions::columns:"), std::string("message: ") + e.what());
-      return std::nullopt;
+      return CheckMessageQuoting(e.what(), "ColumnMap::Parse");
     } catch (const Error& e) {
       return std::string("ColumnMap::Parse threw a cheval::Error that is not a UsageError: ") + e.what();
     }

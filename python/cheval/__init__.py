@@ -33,8 +33,6 @@ from ._cheval import (  # noqa: F401  (re-exported)
     Trajectory,
     UsageError,
     simulate,
-    write,
-    write_model,
 )
 
 __all__ = [
@@ -56,6 +54,17 @@ _DEFAULTS = _cheval.defaults()
 _T_MAX_DIFF, _T_OFFSET = _DEFAULTS["t_max_diff"], _DEFAULTS["t_offset"]
 
 
+def _path(path, keyword="path"):
+    """A path argument (str or os.PathLike) as text; one with a NUL byte, which the C library would cut
+    short at the NUL, raises UsageError (a ValueError) naming the keyword."""
+    text = _os.fspath(path)
+    if isinstance(text, bytes):
+        text = _os.fsdecode(text)
+    if "\0" in text:
+        raise UsageError(f"{keyword}: the file name contains a NUL byte (\\0); expected a path")
+    return text
+
+
 def _columns_text(columns):
     """A column map given as a list of role names, or as the CLI's comma-separated text."""
     if columns is None:
@@ -71,13 +80,27 @@ def read(path, format="auto", columns=None, kitti_times=None):
     '_' skips a column); kitti_times: a file with one stamp (seconds) per KITTI pose.
     Raises InputError ('PATH:LINE:COLUMN: error: ...') for bad input, UsageError for bad arguments.
     """
-    return _cheval.read(_os.fspath(path), format, _columns_text(columns),
-                        "" if kitti_times is None else _os.fspath(kitti_times))
+    return _cheval.read(_path(path), format, _columns_text(columns),
+                        "" if kitti_times is None else _path(kitti_times, "kitti_times"))
+
+
+def write(trajectory, path, format="tum"):
+    """Writes a trajectory atomically (a temporary file renamed into place) in tum, tumv, euroc or
+    kitti, and only what cheval.read reads back. Raises ComputeError when the trajectory lacks what
+    the format needs (orientation; velocity for tumv) or holds what no reader accepts (no pose),
+    before anything is written, and OutputError when the file cannot be written.
+    """
+    _cheval.write(trajectory, _path(path), format)
 
 
 def read_model(path):
     """Reads a model file written by ``cheval.write_model`` or ``cheval compress`` (a Model)."""
-    return _cheval.read_model(_os.fspath(path))
+    return _cheval.read_model(_path(path))
+
+
+def write_model(model, path):
+    """Writes a model file atomically (OutputError when it cannot)."""
+    _cheval.write_model(model, _path(path))
 
 
 def _trajectory(source, format="auto", columns=None, kitti_times=None):
@@ -135,6 +158,7 @@ def fit(source, values=None, *, degree="auto", window=None, noise=None, format="
     samples; default estimated). See cheval.Curve.
     """
     if values is not None:
+        _cheval.check_real(values, "values")
         return _cheval.fit(source, values, degree=degree, window=window, noise=noise)
     return _cheval.fit(_trajectory(source, format, columns, kitti_times), degree=degree, window=window,
                        noise=noise)
@@ -147,6 +171,7 @@ def compress(source, values=None, *, tolerance=None, format="auto", columns=None
     None for the automatic fit. Returns a Compression (.model, .ratio, .max_error, ...).
     """
     if values is not None:
+        _cheval.check_real(values, "values")
         return _cheval.compress(source, values, tolerance=tolerance)
     return _cheval.compress(_trajectory(source, format, columns, kitti_times), tolerance=tolerance)
 
@@ -276,7 +301,7 @@ def simulate_quadrotor(scenario, output, *, seed=1, duration=10.0, vehicle=DEFAU
     truth.csv in ``output``. scenario: 'hover', 'line', 'circle', 'figure8', 'lissajous' or
     'aggressive'; vehicle: a vehicle + camera JSON file.
     """
-    _cheval.simulate_quadrotor(scenario, _os.fspath(output), seed, float(duration), _os.fspath(vehicle))
+    _cheval.simulate_quadrotor(scenario, _path(output, "output"), seed, float(duration), _path(vehicle, "vehicle"))
 
 
 def estimate_quadrotor(*, scenario=None, data=None, seed=1, duration=10.0, vehicle=None, degree=None, segment=None):
@@ -295,8 +320,8 @@ def estimate_quadrotor(*, scenario=None, data=None, seed=1, duration=10.0, vehic
     """
     if scenario is not None and vehicle is None:
         vehicle = DEFAULT_VEHICLE
-    text, arrays = _cheval.estimate_quadrotor(scenario, None if data is None else _os.fspath(data), seed,
-                                              float(duration), None if vehicle is None else _os.fspath(vehicle),
+    text, arrays = _cheval.estimate_quadrotor(scenario, None if data is None else _path(data, "data"), seed,
+                                              float(duration), None if vehicle is None else _path(vehicle, "vehicle"),
                                               None if degree is None else int(degree),
                                               None if segment is None else float(segment))
     result = _json.loads(text)

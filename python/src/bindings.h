@@ -67,8 +67,18 @@ py::array AdoptMatrix(Eigen::MatrixXd&& matrix);
 
 /// Integer stamps (nanoseconds) from a numpy array or sequence: a view when it is already a
 /// contiguous int64 array, else a converted copy. Floating-point input is refused with a TypeError
-/// (seconds would be silently truncated). The returned array keeps the memory alive.
+/// (seconds would be silently truncated); an unsigned stamp beyond int64 (>= 2^63, which a cast would
+/// wrap to a negative one) and stamps spanning more than int64 nanoseconds (traj::StampSpan) with
+/// InputError, the readers' messages. The returned array keeps the memory alive.
 py::array_t<int64_t> StampsArray(const py::handle& stamps);
+/// A C-ordered float64 array of real numbers from `values` (a numpy array or a sequence): a view when
+/// it already is one, else a converted copy. A complex array (whose imaginary part a conversion would
+/// drop), or one of text, bytes or objects, is refused with InputError naming the argument `name`.
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+DoubleArray RealArray(const py::handle& values, const char* name);
+/// The check of RealArray alone, without a conversion: InputError for a complex or text `array`.
+void CheckReal(const py::array& array, const char* name);
+
 inline std::span<const int64_t> SpanOf(const py::array_t<int64_t>& stamps) {
   return {stamps.data(), static_cast<size_t>(stamps.size())};
 }

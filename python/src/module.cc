@@ -5,7 +5,10 @@
 #include <string>
 
 #include "bindings.h"
+#include <fmt/format.h>
+
 #include "cheval/common/error.h"
+#include "cheval/traj/validate.h"
 
 namespace cheval::python {
 namespace {
@@ -105,7 +108,51 @@ py::array_t<int64_t> StampsArray(const py::handle& stamps) {
                          "; from seconds: numpy.round(seconds * 1e9).astype(numpy.int64)");
   }
   if (array.ndim() != 1) throw py::value_error("stamps: expected a 1-D array, got " + std::to_string(array.ndim()) + "-D");
-  return py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(array);
+  if (kind == 'u' && array.itemsize() == sizeof(uint64_t)) {
+    // A cast to int64 would wrap 2^63 and beyond to negative stamps.
+    const auto unsigned_stamps = py::array_t<uint64_t, py::array::forcecast>::ensure(array);
+    const auto view = unsigned_stamps.unchecked<1>();
+    for (py::ssize_t i = 0; i < view.shape(0); ++i) {
+      if (view(i) > static_cast<uint64_t>(INT64_MAX)) {
+        throw InputError("<array>", 0, 0,
+                         fmt::format("row {}: {}", i, traj::StampOutOfRangeMessage(std::to_string(view(i)),
+                                                                                    fmt::format("stamps[{}]", i))));
+      }
+    }
+  }
+  auto converted = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(array);
+  // Every difference of two stamps must fit int64, as in a file (traj::StampSpan).
+  traj::StampSpan span;
+  const int64_t* data = converted.data();
+  for (py::ssize_t i = 0; i < converted.size(); ++i) {
+    if (auto problem = span.Add(data[i], i, "row")) {
+      throw InputError("<array>", 0, 0, fmt::format("row {}: {}", i, *problem));
+    }
+  }
+  return converted;
+}
+
+DoubleArray RealArray(const py::handle& values, const char* name) {
+  const py::array array = py::array::ensure(values);
+  if (!array) throw py::type_error(fmt::format("{}: expected an array of numbers", name));
+  CheckReal(array, name);
+  DoubleArray converted = DoubleArray::ensure(array);
+  if (!converted) throw py::type_error(fmt::format("{}: expected an array of real numbers", name));
+  return converted;
+}
+
+void CheckReal(const py::array& array, const char* name) {
+  const char kind = array.dtype().kind();
+  if (kind == 'c') {
+    throw InputError("<array>", 0, 0,
+                     fmt::format("{}: complex values (dtype {}) are not accepted; expected real numbers (a conversion "
+                                 "would drop the imaginary part)",
+                                 name, py::str(array.dtype()).cast<std::string>()));
+  }
+  if (kind != 'f' && kind != 'i' && kind != 'u' && kind != 'b' && kind != 'O') {
+    throw InputError("<array>", 0, 0,
+                     fmt::format("{}: expected real numbers, got dtype {}", name, py::str(array.dtype()).cast<std::string>()));
+  }
 }
 
 }  // namespace cheval::python

@@ -8,13 +8,12 @@
 #include "bindings.h"
 #include "cheval/common/error.h"
 #include "cheval/sim/motion.h"
+#include "cheval/traj/validate.h"
 
 namespace cheval::python {
 namespace {
 
 constexpr auto kDouble = static_cast<py::ssize_t>(sizeof(double));
-
-using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 // Checks that `array` is (n, columns); UsageError naming the argument otherwise.
 void CheckShape(const DoubleArray& array, py::ssize_t n, py::ssize_t columns, const char* name) {
@@ -25,10 +24,21 @@ void CheckShape(const DoubleArray& array, py::ssize_t n, py::ssize_t columns, co
   }
 }
 
-PyTrajectory FromArrays(const py::handle& stamps_in, const DoubleArray& positions,
-                        const std::optional<DoubleArray>& quaternions, const std::optional<DoubleArray>& velocities,
-                        const std::optional<DoubleArray>& angular_velocities) {
+// An optional array argument as doubles (RealArray), or nullopt for None.
+std::optional<DoubleArray> OptionalRealArray(const py::handle& values, const char* name) {
+  if (values.is_none()) return std::nullopt;
+  return RealArray(values, name);
+}
+
+// Builds a trajectory from arrays and checks its values as the readers check a file's
+// (traj::ValidatePoses: finite values, rotations, stamp span; InputError, a ValueError, naming the row).
+PyTrajectory FromArrays(const py::handle& stamps_in, const py::handle& positions_in, const py::handle& quaternions_in,
+                        const py::handle& velocities_in, const py::handle& angular_velocities_in) {
   const py::array_t<int64_t> stamps = StampsArray(stamps_in);
+  const DoubleArray positions = RealArray(positions_in, "positions");
+  const std::optional<DoubleArray> quaternions = OptionalRealArray(quaternions_in, "quaternions");
+  const std::optional<DoubleArray> velocities = OptionalRealArray(velocities_in, "velocities");
+  const std::optional<DoubleArray> angular_velocities = OptionalRealArray(angular_velocities_in, "angular_velocities");
   const py::ssize_t n = stamps.size();
   CheckShape(positions, n, 3, "positions");
   if (quaternions) CheckShape(*quaternions, n, 4, "quaternions");
@@ -45,6 +55,7 @@ PyTrajectory FromArrays(const py::handle& stamps_in, const DoubleArray& position
     out.trajectory.Append(stamps.at(i), positions.data(i, 0), row(quaternions, i), row(velocities, i),
                           row(angular_velocities, i));
   }
+  traj::ValidatePoses(out.trajectory.View(), out.path);
   return out;
 }
 
@@ -174,6 +185,14 @@ are immutable; the array properties are read-only views of the stored data (no c
           },
           py::arg("format") = "tum",
           "The trajectory as the text of a file in `format` (tum, tumv, euroc, kitti), as cheval.write writes it.");
+
+  m.def(
+      "check_real",
+      [](const py::handle& values, const std::string& name) {
+        const py::array array = py::array::ensure(values);
+        if (array) CheckReal(array, name.c_str());
+      },
+      "Raises InputError for a complex (or text) array `values`, named `name`, as Trajectory() does.");
 
   m.def(
       "read",

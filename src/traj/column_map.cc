@@ -9,6 +9,7 @@
 #include "cheval/common/error.h"
 #include "cheval/common/options.h"
 #include "cheval/traj/io.h"
+#include "cheval/traj/validate.h"
 
 namespace cheval::traj {
 namespace {
@@ -63,12 +64,12 @@ ColumnMap ColumnMap::Parse(std::string_view spec) {
                                  [&](const auto& entry) { return entry.second == token; });
     if (it == kRoleNames.end()) {
       throw UsageError(fmt::format(
-          "ReadOptions::columns: unknown column role '{}' (position {}); expected one of t, t_ms, t_us, t_ns, px, py, pz, "
+          "ReadOptions::columns: unknown column role {} (position {}); expected one of t, t_ms, t_us, t_ns, px, py, pz, "
           "qx, qy, qz, qw, roll, pitch, yaw, vx, vy, vz, wx, wy, wz, or _ to skip a column",
-          token, map.roles.size() + 1));
+          QuoteField(token), map.roles.size() + 1));
     }
     if (it->first != ColumnRole::kSkip && !seen.insert(it->first).second) {
-      throw UsageError(fmt::format("ReadOptions::columns: role '{}' appears twice", token));
+      throw UsageError(fmt::format("ReadOptions::columns: role {} appears twice", QuoteField(token)));
     }
     map.roles.push_back(it->first);
     if (comma == std::string_view::npos) break;
@@ -115,7 +116,7 @@ ReadOptions ReadOptions::FromNames(std::string_view format, std::string_view col
   const OptionCheck check("ReadOptions");
   ReadOptions options;
   const std::optional<Format> parsed = FormatFromString(format);
-  check(parsed.has_value(), "format", "names an unknown format '{}' (auto, tum, tumv, euroc, kitti, vins, csv)", format);
+  check(parsed.has_value(), "format", "names an unknown format {} (auto, tum, tumv, euroc, kitti, vins, csv)", QuoteField(format));
   options.format = *parsed;
   if (!columns.empty()) {
     check(options.format == Format::kCsv || options.format == Format::kAuto, "columns",

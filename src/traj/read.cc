@@ -13,17 +13,18 @@
 #include <memory>
 #include <sstream>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <fmt/format.h>
 
 #include "cheval/common/error.h"
 #include "cheval/traj/io.h"
 #include "cheval/traj/stamp.h"
+#include "cheval/traj/validate.h"
 
 namespace cheval::traj {
 namespace {
-
-// n = q·q below this is a zero quaternion (evo's threshold for "identity", 4·machine epsilon).
-constexpr double kZeroQuaternionNormSquared = 8.881784197001252e-16;
 
 struct Field {
   std::string_view text;
@@ -156,8 +157,12 @@ bool RoundsToZero(std::string_view text) {
 // ±0: that is its correctly rounded value, the one strtod, Python's float() and numpy.loadtxt (so
 // evo) give, just as 1e-320 rounds to a subnormal and 0.1 to the nearest double.
 std::optional<double> ParseDouble(std::string_view text) {
-  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-  if (text.empty() || text.front() == '+' || (text.front() == '-' && text.size() > 1 && text[1] == '+')) {
+  // One sign at most: "+-1", "-+1" and "++1" are no numbers (from_chars would read "-1" after a '+').
+  if (!text.empty() && text.front() == '+') {
+    text.remove_prefix(1);
+    if (!text.empty() && (text.front() == '+' || text.front() == '-')) return std::nullopt;
+  }
+  if (text.empty() || (text.front() == '-' && text.size() > 1 && (text[1] == '+' || text[1] == '-'))) {
     return std::nullopt;
   }
   double value = 0.0;
@@ -372,14 +377,13 @@ class Reader {
     if (field.text.empty()) Fail(field.column, fmt::format("{} is empty; expected a number", FieldName(layout, index)));
     const std::optional<double> value = ParseDouble(field.text);
     if (!value) {
-      Fail(field.column, fmt::format("expected a number for {}, got '{}'", FieldName(layout, index), field.text));
+      Fail(field.column, fmt::format("expected a number for {}, got {}", FieldName(layout, index), QuoteField(field.text)));
     }
     if (!std::isfinite(*value)) {
       // Either spelt as such ("inf", "nan", ...) or a decimal beyond the range of a double.
       const size_t first = field.text.find_first_not_of("+-");
       const bool spelt = first != std::string_view::npos && std::isalpha(static_cast<unsigned char>(field.text[first]));
-      Fail(field.column, fmt::format("{} is '{}'{}; expected a finite number", FieldName(layout, index), field.text,
-                                     spelt ? "" : ", too large for a double (at most 1.8e308 in magnitude)"));
+      Fail(field.column, NotFiniteMessage(FieldName(layout, index), QuoteField(field.text), !spelt));
     }
     return *value;
   }
@@ -399,14 +403,13 @@ class Reader {
     if (!r.error) return r.value;
     switch (*r.error) {
       case StampParseError::kNotANumber:
-        Fail(field.column, fmt::format("expected a time stamp in {} for {}, got '{}'", unit,
-                                       FieldName(layout, index), field.text));
+        Fail(field.column, fmt::format("expected a time stamp in {} for {}, got {}", unit,
+                                       FieldName(layout, index), QuoteField(field.text)));
       case StampParseError::kOutOfRange:
-        Fail(field.column, fmt::format("time stamp '{}' in {} is out of range (int64 nanoseconds, about ±292 years)",
-                                       field.text, FieldName(layout, index)));
+        Fail(field.column, StampOutOfRangeMessage(QuoteField(field.text), FieldName(layout, index)));
       case StampParseError::kNotAnInteger:
-        Fail(field.column, fmt::format("expected an integer number of nanoseconds for {}, got '{}'",
-                                       FieldName(layout, index), field.text));
+        Fail(field.column, fmt::format("expected an integer number of nanoseconds for {}, got {}",
+                                       FieldName(layout, index), QuoteField(field.text)));
     }
     Fail(field.column, "bad time stamp");
   }
@@ -415,6 +418,7 @@ class Reader {
     if (layout.kitti) return ParseKittiRow(layout, fields, trajectory);
     int64_t stamp = 0;
     double p[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, euler[3] = {0, 0, 0}, v[3] = {0, 0, 0}, w[3] = {0, 0, 0};
+    size_t time_field = 0;
     for (size_t i = 0; i < layout.roles.size(); ++i) {
       const ColumnRole role = layout.roles[i];
       switch (role) {
@@ -422,7 +426,7 @@ class Reader {
         case ColumnRole::kTimeSeconds:
         case ColumnRole::kTimeMilliseconds:
         case ColumnRole::kTimeMicroseconds:
-        case ColumnRole::kTimeNanoseconds: stamp = Stamp(layout, fields, i, role); break;
+        case ColumnRole::kTimeNanoseconds: stamp = Stamp(layout, fields, i, role), time_field = i; break;
         case ColumnRole::kPx: p[0] = Number(layout, fields, i); break;
         case ColumnRole::kPy: p[1] = Number(layout, fields, i); break;
         case ColumnRole::kPz: p[2] = Number(layout, fields, i); break;
@@ -448,19 +452,11 @@ class Reader {
       const Eigen::Quaterniond rotation = QuaternionFromRollPitchYaw(euler[0], euler[1], euler[2]);
       q[0] = rotation.x(), q[1] = rotation.y(), q[2] = rotation.z(), q[3] = rotation.w();
     } else if (layout.orientation == OrientationKind::kQuaternion) {
-      const double n = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
-      if (n < kZeroQuaternionNormSquared) {
-        Fail(fields[layout.first_quaternion_field].column,
-             fmt::format("quaternion ({}) has zero norm; expected a rotation", QuaternionNames(layout)));
-      }
-      // Each value is finite, but n can still overflow (e.g. qx = 1e175); the rotation would silently
-      // become the identity (sqrt(2/n) = 0), so such a quaternion is no rotation either.
-      if (!std::isfinite(n)) {
-        Fail(fields[layout.first_quaternion_field].column,
-             fmt::format("quaternion ({}) is too large: its squared norm overflows a double; expected a rotation",
-                         QuaternionNames(layout)));
+      if (auto problem = QuaternionProblem(q[0], q[1], q[2], q[3], QuaternionNames(layout))) {
+        Fail(fields[layout.first_quaternion_field].column, *problem);
       }
     }
+    if (auto problem = span_.Add(stamp, scanner_.line_number(), "line")) Fail(fields[time_field].column, *problem);
     trajectory->Append(stamp, p, q, v, w);
   }
 
@@ -502,23 +498,94 @@ class Reader {
   LineScanner scanner_;
   size_t content_size_;
   std::string path_;
+  StampSpan span_;
 };
 
+// "N bytes (X MiB)" for messages about sizes.
+std::string Bytes(uint64_t bytes) {
+  return bytes >= (uint64_t{1} << 30) ? fmt::format("{} bytes ({:.3g} GiB)", bytes, static_cast<double>(bytes) / (1 << 30))
+                                      : fmt::format("{} bytes ({:.3g} MiB)", bytes, static_cast<double>(bytes) / (1 << 20));
+}
+
+// Checks the bytes appended to `content` from `from` on, as they arrive: no NUL byte (a text file
+// has none; /dev/zero and binary files stop at the first chunk) and no line longer than
+// kMaxInputLineBytes. `line_start` (the offset where the current line begins) and `line` (its
+// number) carry over between calls.
+void CheckNewBytes(const std::string& path, std::string_view content, size_t from, size_t* line_start, int64_t* line) {
+  const auto fail_long = [&](size_t length) {
+    throw InputError(path, *line, 1,
+                     fmt::format("no newline in the first {} of this line; expected lines of a trajectory file, at "
+                                 "most {} each",
+                                 Bytes(length), Bytes(kMaxInputLineBytes)));
+  };
+  const size_t nul = content.find('\0', from);
+  const size_t stop = nul == std::string_view::npos ? content.size() : nul;
+  for (size_t i = from; i < stop;) {
+    const void* found = std::memchr(content.data() + i, '\n', stop - i);
+    if (found == nullptr) break;
+    const size_t newline = static_cast<size_t>(static_cast<const char*>(found) - content.data());
+    if (newline - *line_start > kMaxInputLineBytes) fail_long(newline - *line_start);
+    *line_start = newline + 1;
+    ++*line;
+    i = newline + 1;
+  }
+  if (stop - *line_start > kMaxInputLineBytes) fail_long(stop - *line_start);
+  if (nul != std::string_view::npos) {
+    throw InputError(path, *line, static_cast<int64_t>(nul - *line_start) + 1,
+                     "contains a NUL byte (\\0); expected a text file");
+  }
+}
+
 std::string ReadWholeFile(const std::string& path) {
-  // One read into a buffer of the file's size (a stringstream copy cost as much as the parsing).
+  if (path.find('\0') != std::string::npos) {
+    throw InputError(QuoteField(path, std::string::npos), 0, 0, "the file name contains a NUL byte (\\0); expected a path");
+  }
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), &std::fclose);
   if (file == nullptr) {
     throw InputError(path, 0, 0, fmt::format("cannot open file: {}", std::strerror(errno)));
   }
+  struct stat status {};
+  if (fstat(fileno(file.get()), &status) != 0) {
+    throw InputError(path, 0, 0, fmt::format("cannot read file: {}", std::strerror(errno)));
+  }
+  if (S_ISDIR(status.st_mode)) throw InputError(path, 0, 0, "is a directory; expected a trajectory file");
+  const uint64_t limit = MaxInputFileBytes();
+  const auto too_large = [&](uint64_t size, const char* what) {
+    return InputError(path, 0, 0,
+                      fmt::format("{} {}; the largest input file read is {} (the smaller of 8 GiB and half the "
+                                  "physical memory)",
+                                  what, Bytes(size), Bytes(limit)));
+  };
   std::string content;
-  std::error_code error;
-  const auto size = std::filesystem::is_regular_file(path, error) ? std::filesystem::file_size(path, error) : 0;
-  if (!error && size > 0) content.resize(size);
-  size_t filled = std::fread(content.data(), 1, content.size(), file.get());
-  content.resize(filled);
-  // Whatever the size said (a pipe, a file that grew), read on to the end.
-  char chunk[65536];
-  while (size_t n = std::fread(chunk, 1, sizeof(chunk), file.get())) content.append(chunk, n);
+  if (S_ISREG(status.st_mode)) {
+    if (static_cast<uint64_t>(status.st_size) > limit) throw too_large(status.st_size, "the file is");
+    content.reserve(static_cast<size_t>(status.st_size));  // one buffer of the file's size, never regrown
+  }
+  // Read in chunks, each checked as it arrives, so that a FIFO, a device or a file without newlines is
+  // refused after at most kMaxInputLineBytes, never read whole into memory first.
+  constexpr size_t kChunk = size_t{1} << 20;
+  size_t line_start = 0;
+  int64_t line = 1;
+  while (true) {
+    const size_t old = content.size();
+    const size_t room = content.capacity() - old;
+    size_t n = 0;
+    if (room == 0) {
+      // Full (a regular file at its end, or a stream): a small read to see whether more follows, so
+      // that the end of a file never doubles its buffer.
+      char probe[4096];
+      n = std::fread(probe, 1, sizeof(probe), file.get());
+      content.append(probe, n);
+    } else {
+      const size_t want = std::min(room, kChunk);
+      content.resize(old + want);
+      n = std::fread(content.data() + old, 1, want, file.get());
+      content.resize(old + n);
+    }
+    if (n == 0) break;
+    CheckNewBytes(path, content, old, &line_start, &line);
+    if (content.size() > limit) throw too_large(content.size(), "the input is more than");
+  }
   if (std::ferror(file.get())) throw InputError(path, 0, 0, fmt::format("cannot read file: {}", std::strerror(errno)));
   return content;
 }
@@ -597,7 +664,7 @@ Format DetectFormat(const std::string& path, std::string_view content) {
                                    "ReadOptions::format {} if the columns are in that order, else ReadOptions::format csv "
                                    "ReadOptions::columns ...",
                                    count, ToString(format), columns, axes,
-                                   named ? fmt::format("its field {} is '{}'", *wrong + 1, header_fields[*wrong].text)
+                                   named ? fmt::format("its field {} is {}", *wrong + 1, QuoteField(header_fields[*wrong].text))
                                          : fmt::format("it has {} names", header_fields.size()),
                                    ToString(format)));
     }
@@ -660,15 +727,23 @@ Trajectory ParseTrajectory(std::string_view content, const std::string& path, co
   return trajectory;
 }
 
-Trajectory ReadTrajectory(const std::string& path, const ReadOptions& options, Format* format_read) {
-  return ParseTrajectory(ReadWholeFile(path), path, options, format_read);
+uint64_t MaxInputFileBytes() {
+  static const uint64_t limit = [] {
+    const long pages = sysconf(_SC_PHYS_PAGES);
+    const long page_size = sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || page_size <= 0) return kMaxInputFileBytes;
+    return std::min(kMaxInputFileBytes, static_cast<uint64_t>(pages) * static_cast<uint64_t>(page_size) / 2);
+  }();
+  return limit;
 }
 
-std::vector<int64_t> ReadStampsFile(const std::string& path) {
-  const std::string content = ReadWholeFile(path);
+namespace {
+
+std::vector<int64_t> ParseStamps(std::string_view content, const std::string& path) {
   LineScanner scanner(content);
   std::vector<Field> fields;
   std::vector<int64_t> stamps;
+  StampSpan span;
   while (scanner.Next()) {
     scanner.Split(' ', &fields);
     if (fields.size() != 1) {
@@ -678,7 +753,10 @@ std::vector<int64_t> ReadStampsFile(const std::string& path) {
     const StampParseResult r = ParseDecimalStamp(fields[0].text, 9);
     if (r.error) {
       throw InputError(path, scanner.line_number(), fields[0].column,
-                       fmt::format("expected a time stamp in seconds, got '{}'", fields[0].text));
+                       fmt::format("expected a time stamp in seconds, got {}", QuoteField(fields[0].text)));
+    }
+    if (auto problem = span.Add(r.value, scanner.line_number(), "line")) {
+      throw InputError(path, scanner.line_number(), fields[0].column, *problem);
     }
     stamps.push_back(r.value);
   }
@@ -687,5 +765,34 @@ std::vector<int64_t> ReadStampsFile(const std::string& path) {
   }
   return stamps;
 }
+
+
+// `read()`, with std::bad_alloc reported as the InputError it is.
+template <typename Read>
+auto WithinMemory(const std::string& path, Read read) -> decltype(read()) {
+  try {
+    return read();
+  } catch (const std::bad_alloc&) {
+    // The file fits the size limit but not the memory left (other processes, a cgroup limit): an
+    // input problem to report with the file and its size, never an internal error.
+    std::error_code error;
+    const uintmax_t size = std::filesystem::file_size(path, error);
+    throw InputError(path, 0, 0,
+                     fmt::format("not enough memory to read {}: the text and the poses need about twice its "
+                                 "size; expected a smaller file or more free memory",
+                                 error ? std::string("it") : "the file of " + Bytes(size)));
+  }
+}
+
+}  // namespace
+
+Trajectory ReadTrajectory(const std::string& path, const ReadOptions& options, Format* format_read) {
+  return WithinMemory(path, [&] { return ParseTrajectory(ReadWholeFile(path), path, options, format_read); });
+}
+
+std::vector<int64_t> ReadStampsFile(const std::string& path) {
+  return WithinMemory(path, [&] { return ParseStamps(ReadWholeFile(path), path); });
+}
+
 
 }  // namespace cheval::traj

@@ -9,6 +9,7 @@
 #include "cheval/common/output.h"
 #include "cheval/traj/io.h"
 #include "cheval/traj/stamp.h"
+#include "cheval/traj/validate.h"
 
 namespace cheval::traj {
 namespace {
@@ -37,6 +38,16 @@ void RequireOrientation(const TrajectoryView& trajectory, Format format) {
 }  // namespace
 
 std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
+  // Only what the readers read back: a file with a NaN, a zero quaternion, stamps beyond int64's
+  // span or no pose at all would be refused by ReadTrajectory, so it is not written.
+  if (trajectory.empty()) {
+    throw ComputeError(fmt::format("cannot write {}: the trajectory has no poses (a file without poses does not read back)",
+                                   ToString(format)));
+  }
+  if (const auto problem = FindPoseProblem(trajectory)) {
+    throw ComputeError(fmt::format("cannot write {}: row {}: {} (the file would not read back)", ToString(format),
+                                   problem->row, problem->what));
+  }
   // Formatted straight into the string that is returned (no copy of the whole text at the end),
   // reserved once for the longest possible lines (a shortest round-trip double has at most 24
   // characters, a stamp at most 21) so that it is never regrown: each regrowth copies the text.
@@ -105,6 +116,9 @@ std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
 }
 
 void WriteTrajectory(const std::string& path, const TrajectoryView& trajectory, Format format) {
+  if (path.find('\0') != std::string::npos) {
+    throw UsageError(fmt::format("{}: the file name contains a NUL byte (\\0); expected a path", QuoteField(path, std::string::npos)));
+  }
   WriteOutput(path, FormatTrajectory(trajectory, format));
 }
 

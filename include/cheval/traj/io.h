@@ -17,6 +17,7 @@
 /// duplicates included (evo keeps them too). Every problem throws cheval::InputError with
 /// `path:line:column`.
 
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
@@ -84,10 +85,24 @@ struct ReadOptions {
 /// explaining what was seen when no format fits (suggesting format csv with a column map).
 Format DetectFormat(const std::string& path, std::string_view content);
 
+/// Default largest input file the readers accept, 8 GiB (see MaxInputFileBytes).
+inline constexpr uint64_t kMaxInputFileBytes = uint64_t{8} << 30;
+/// Longest line of an input file, 1 MiB: a line with no newline within it (a binary file, a device)
+/// is refused as soon as that much of it has been read.
+inline constexpr size_t kMaxInputLineBytes = size_t{1} << 20;
+
+/// The largest input file the readers accept: the smaller of kMaxInputFileBytes and half the
+/// machine's physical memory (reading needs the text and the poses, about twice the file).
+uint64_t MaxInputFileBytes();
+
 /// Reads a trajectory file. Throws InputError (`path:line:column: error: ...`) on any problem:
 /// missing or unreadable file, empty file, wrong field count, non-number, NaN/Inf, truncated last
 /// line, zero-norm quaternion (or one whose squared norm overflows), a non-rotation KITTI matrix
-/// (determinant or R·Rᵀ off from 1 / I by more than 0.1), a KITTI times file of another length.
+/// (determinant or R·Rᵀ off from 1 / I by more than 0.1), a KITTI times file of another length,
+/// stamps spanning more than int64 nanoseconds (traj/validate.h, StampSpan), a file larger than
+/// MaxInputFileBytes(), a line longer than kMaxInputLineBytes, a NUL byte, a path containing a NUL
+/// byte, and a file that does not fit in the memory left (std::bad_alloc while reading). The input is
+/// read in chunks, each checked as it arrives, so a FIFO or device is never read without bound.
 /// If `format_read` is given, it receives the format used (the detected one for kAuto).
 Trajectory ReadTrajectory(const std::string& path, const ReadOptions& options = {}, Format* format_read = nullptr);
 
@@ -95,14 +110,16 @@ Trajectory ReadTrajectory(const std::string& path, const ReadOptions& options = 
 Trajectory ParseTrajectory(std::string_view content, const std::string& path, const ReadOptions& options = {},
                            Format* format_read = nullptr);
 
-/// Reads a file of one stamp per line (seconds, e.g. a KITTI times file); InputError on problems.
+/// Reads a file of one stamp per line (seconds, e.g. a KITTI times file); InputError on problems
+/// (the same limits as ReadTrajectory).
 std::vector<int64_t> ReadStampsFile(const std::string& path);
 
 /// The text of `trajectory` in `format` (kTum, kTumV, kEuroc or kKitti). Numbers are written in the
 /// shortest form that reads back to the same double; stamps as seconds with nine decimals (TUM) or
 /// integer nanoseconds (EuRoC). Quaternions are written as read. Throws ComputeError if the
-/// trajectory lacks what the format needs (orientation; velocity for tumv) and UsageError for a
-/// format that cannot be written.
+/// trajectory lacks what the format needs (orientation; velocity for tumv) or holds what the readers
+/// would refuse (no pose, FindPoseProblem of traj/validate.h: NaN, zero quaternion, stamp span), so
+/// that whatever is written reads back; UsageError for a format that cannot be written.
 std::string FormatTrajectory(const TrajectoryView& trajectory, Format format);
 
 /// Writes FormatTrajectory() to `path` atomically: a temporary file beside it is written, flushed
