@@ -1,6 +1,8 @@
 #include "cheval/cheb/model.h"
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <cmath>
 #include <stdexcept>
 
@@ -91,6 +93,60 @@ Curve CurveFromModel(const TrajectoryModel& model) {
   }
   return Curve::FromParts(model.origin_ns, std::move(segments), OrZeros(model.noise_sigma, d),
                           OrZeros(model.residual_rms, d));
+}
+
+namespace {
+
+// FNV-1a, 64 bits (Fowler, Noll, Vo): per byte, xor then multiply by the FNV prime.
+class Fnv1a64 {
+ public:
+  void Add(uint64_t word) {  // 8 bytes, least significant first, whatever the machine's order
+    for (int i = 0; i < 8; ++i) {
+      hash_ ^= (word >> (8 * i)) & 0xff;
+      hash_ *= 0x100000001b3ULL;
+    }
+  }
+  void Add(double x) { Add(std::bit_cast<uint64_t>(x)); }
+  void Add(int64_t x) { Add(static_cast<uint64_t>(x)); }
+  void Add(const Eigen::VectorXd& v) {
+    Add(static_cast<int64_t>(v.size()));
+    for (Eigen::Index i = 0; i < v.size(); ++i) Add(v[i]);
+  }
+  uint64_t hash() const { return hash_; }
+
+ private:
+  uint64_t hash_ = 0xcbf29ce484222325ULL;
+};
+
+}  // namespace
+
+uint64_t ModelChecksum(const TrajectoryModel& model) {
+  Fnv1a64 h;
+  h.Add(int64_t{model.dimension});
+  h.Add(model.origin_ns);
+  h.Add(model.noise_sigma);
+  h.Add(model.residual_rms);
+  h.Add(int64_t{model.reconstruction.has_value()});
+  if (model.reconstruction) {
+    h.Add(static_cast<int64_t>(model.reconstruction->samples));
+    h.Add(model.reconstruction->max);
+    h.Add(model.reconstruction->rms);
+    h.Add(model.reconstruction->worst_stamp_ns);
+  }
+  h.Add(int64_t{model.tolerance.has_value()});
+  if (model.tolerance) h.Add(*model.tolerance);
+  h.Add(static_cast<int64_t>(model.segments.size()));
+  for (const ModelSegment& segment : model.segments) {
+    h.Add(segment.first_ns);
+    h.Add(segment.last_ns);
+    h.Add(static_cast<int64_t>(segment.windows.size()));
+    for (const ModelWindow& window : segment.windows) {
+      for (double end : {window.core_begin, window.core_end, window.fit_begin, window.fit_end}) h.Add(end);
+      h.Add(static_cast<int64_t>(window.values.size()));
+      for (const Eigen::VectorXd& values : window.values) h.Add(values);
+    }
+  }
+  return h.hash();
 }
 
 Eigen::Index ModelValueCount(const TrajectoryModel& model) {

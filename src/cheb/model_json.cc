@@ -1,13 +1,8 @@
 // The JSON form of a TrajectoryModel (docs/compress.md, "Schema"): a hand-laid writer that keeps a
 // window per few lines, and a validating reader that names the element at fault.
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
-#include <fstream>
 #include <initializer_list>
-#include <iterator>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -19,12 +14,19 @@
 
 #include "cheval/cheb/model.h"
 #include "cheval/common/error.h"
+#include "cheval/common/input_file.h"
 
 namespace cheval::cheb {
 namespace {
 
 constexpr const char* kFormat = "cheval-trajectory-model";
-constexpr int kVersion = 1;
+constexpr int kVersion = 2;         // written; carries a checksum
+constexpr int kLegacyVersion = 1;   // read: models written before the checksum existed
+constexpr const char* kChecksumPrefix = "fnv1a64:";
+// A model file beyond this is refused before it is read (compressing a day at 1 kHz gives ~10 MB).
+constexpr uint64_t kMaxModelFileBytes = uint64_t{1} << 30;
+
+std::string ChecksumText(uint64_t checksum) { return fmt::format("{}{:016x}", kChecksumPrefix, checksum); }
 // Stamps are differenced in int64 and converted to seconds in a double, which is exact up to 2^53 ns
 // (about 104 days): a model may span no more than that from its origin.
 constexpr int64_t kMaxSpanNs = int64_t{1} << 53;
@@ -79,10 +81,21 @@ class ModelReader {
     }
     CheckKeys(root, "model",
               {"format", "version", "dimension", "origin_ns", "noise_sigma", "residual_rms", "reconstruction",
-               "tolerance", "segments"});
+               "tolerance", "segments", "checksum"});
     const Json& version = Require(root, "version", "");
-    if (!version.is_number_integer() || version.get<int64_t>() != kVersion) {
-      Fail("version", fmt::format("expected {} (the version this cheval reads), got {}", kVersion, Describe(version)));
+    if (!version.is_number_integer() ||
+        (version.get<int64_t>() != kVersion && version.get<int64_t>() != kLegacyVersion)) {
+      Fail("version", fmt::format("expected {} or {} (the versions this cheval reads), got {}", kLegacyVersion,
+                                  kVersion, Describe(version)));
+    }
+    const bool checked = version.get<int64_t>() == kVersion;
+    if (!checked && root.contains("checksum")) {
+      Fail("checksum", fmt::format("unexpected in a version {} model (version {} models have none)", kLegacyVersion,
+                                   kLegacyVersion));
+    }
+    if (checked && !root.contains("checksum")) {
+      Fail("checksum", fmt::format("missing; expected \"{}<16 hex digits>\" in a version {} model", kChecksumPrefix,
+                                   kVersion));
     }
     TrajectoryModel model;
     const Json& dimension = Require(root, "dimension", "");
@@ -111,6 +124,15 @@ class ModelReader {
     }
     for (size_t k = 0; k < segments.size(); ++k) {
       model.segments.push_back(Segment(segments[k], fmt::format("segments[{}]", k), model, k));
+    }
+    if (checked) {
+      const Json& stored = root["checksum"];
+      const std::string expected = ChecksumText(ModelChecksum(model));
+      if (!stored.is_string() || stored.get<std::string>() != expected) {
+        Fail("checksum", fmt::format("checksum mismatch: the file says {}, its numbers give {}; the model is "
+                                     "corrupted or was edited (docs/compress.md, \"Checksum\")",
+                                     Describe(stored), expected));
+      }
     }
     try {
       (void)CurveFromModel(model);  // every check FromParts makes has been made above; this is a backstop
@@ -327,40 +349,15 @@ std::string WriteModelJson(const TrajectoryModel& model) {
     }
     out += "]}";
   }
-  return out + "\n  ]\n}\n";
+  return out + fmt::format("\n  ],\n  \"checksum\": \"{}\"\n}}\n", ChecksumText(ModelChecksum(model)));
 }
 
 TrajectoryModel ParseModelJson(std::string_view text, const std::string& path) {
-  Json root;
-  try {
-    root = Json::parse(text.begin(), text.end());
-  } catch (const Json::parse_error& e) {
-    // nlohmann's message: "[json.exception.parse_error.101] parse error at line L, column C: WHAT".
-    const std::string message = e.what();
-    long line = 0, column = 0;
-    const size_t at = message.find(" at line ");
-    if (at != std::string::npos) std::sscanf(message.c_str() + at, " at line %ld, column %ld", &line, &column);
-    const size_t colon = message.find(": ", at == std::string::npos ? 0 : at);
-    throw InputError(path, line, column,
-                     "expected JSON (a cheval trajectory model): " +
-                         (colon == std::string::npos ? message : message.substr(colon + 2)));
-  } catch (const Json::exception& e) {
-    // E.g. "[json.exception.out_of_range.406] number overflow parsing '1e999'": no position given.
-    const std::string message = e.what();
-    const size_t bracket = message.find("] ");
-    throw InputError(path, 0, 0,
-                     "expected JSON (a cheval trajectory model): " +
-                         (bracket == std::string::npos ? message : message.substr(bracket + 2)));
-  }
-  return ModelReader(path).Read(root);
+  return ModelReader(path).Read(ParseJsonInput(text, path, "a cheval trajectory model"));
 }
 
 TrajectoryModel ReadModel(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, 0, fmt::format("cannot open file: {}", std::strerror(errno)));
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) throw InputError(path, 0, 0, "cannot read file");
-  return ParseModelJson(text, path);
+  return ParseModelJson(ReadInputFile(path, kMaxModelFileBytes, "a model JSON file from cheval compress"), path);
 }
 
 }  // namespace cheval::cheb

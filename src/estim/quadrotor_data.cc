@@ -8,10 +8,11 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
+#include <string_view>
 #include <system_error>
 
 #include "cheval/common/error.h"
+#include "cheval/common/input_file.h"
 #include "cheval/common/output.h"
 
 namespace cheval::estim {
@@ -19,15 +20,38 @@ namespace {
 
 std::string Num(double x) { return fmt::format("{:.17g}", x); }
 
-// Rows of a CSV file with a header line; every row must have `columns` numbers.
-std::vector<std::vector<double>> ReadCsv(const std::filesystem::path& path, size_t columns) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string(), 0, 0, "cannot open (required file of a quadrotor data folder)");
+// The rows of a CSV file with an optional header line (a first line not starting with a number),
+// each with its 1-based line number; every row must have `columns` finite numbers. Lines may end in
+// LF or CRLF; empty lines and lines starting with '#' are skipped.
+struct CsvRows {
+  std::string path;
   std::vector<std::vector<double>> rows;
-  std::string line;
+  std::vector<int64_t> lines;
+
+  [[noreturn]] void Fail(size_t row, int64_t column, const std::string& what) const {
+    throw InputError(path, lines[row], column, what);
+  }
+  // Fails unless |rows[row][column]| <= bound (the value is finite already).
+  void Bounded(size_t row, size_t column, double bound, const char* name, const char* unit) const {
+    const double value = rows[row][column];
+    if (!(std::abs(value) <= bound)) {
+      Fail(row, 0, fmt::format("{} must be within [-{:g}, {:g}] {}, got {}", name, bound, bound, unit, value));
+    }
+  }
+};
+
+CsvRows ReadCsv(const std::filesystem::path& file, size_t columns) {
+  CsvRows out{file.string(), {}, {}};
+  const std::string text = ReadInputFile(out.path, kMaxDataFileBytes, "a CSV file of a quadrotor data folder");
   int64_t number = 0;
-  while (std::getline(in, line)) {
+  size_t start = 0;
+  while (start < text.size()) {
+    const size_t newline = text.find('\n', start);
+    const size_t stop = newline == std::string::npos ? text.size() : newline;
+    std::string_view line(text.data() + start, stop - start);
+    start = stop + 1;
     ++number;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (line.empty() || line[0] == '#' || (number == 1 && !std::isdigit(static_cast<unsigned char>(line[0])) &&
                                            line[0] != '-' && line[0] != '.')) {
       continue;
@@ -39,19 +63,49 @@ std::vector<std::vector<double>> ReadCsv(const std::filesystem::path& path, size
       double value = 0;
       const auto [next, ec] = std::from_chars(p, end, value);
       if (ec != std::errc() || !std::isfinite(value)) {
-        throw InputError(path.string(), number, p - line.data() + 1, "expected a finite number");
+        throw InputError(out.path, number, p - line.data() + 1, "expected a finite number");
       }
       row.push_back(value);
       p = next;
-      if (p < end && *p == ',') ++p;
-      else if (p < end) throw InputError(path.string(), number, p - line.data() + 1, "expected ','");
+      if (p < end && *p == ',') {
+        ++p;
+        if (p == end) throw InputError(out.path, number, p - line.data() + 1, "expected a number after ','");
+      } else if (p < end) {
+        throw InputError(out.path, number, p - line.data() + 1, "expected ','");
+      }
     }
     if (row.size() != columns) {
-      throw InputError(path.string(), number, 1, fmt::format("expected {} fields, got {}", columns, row.size()));
+      throw InputError(out.path, number, 1, fmt::format("expected {} fields, got {}", columns, row.size()));
     }
-    rows.push_back(std::move(row));
+    out.rows.push_back(std::move(row));
+    out.lines.push_back(number);
   }
-  return rows;
+  return out;
+}
+
+// The unit quaternion of (w, x, y, z) = row[at..at+3]; fails for a zero or overflowing one.
+Eigen::Quaterniond RowQuaternion(const CsvRows& csv, size_t row, size_t at) {
+  const std::vector<double>& r = csv.rows[row];
+  const Eigen::Quaterniond q(r[at], r[at + 1], r[at + 2], r[at + 3]);
+  const double n = q.squaredNorm();
+  if (!(n > 1e-12) || !std::isfinite(n)) {
+    csv.Fail(row, 0,
+             fmt::format("expected a rotation: the quaternion (qw, qx, qy, qz) = ({}, {}, {}, {}) has a squared norm "
+                         "{} (it must be > 1e-12 and finite)",
+                         r[at], r[at + 1], r[at + 2], r[at + 3], n));
+  }
+  return q.normalized();
+}
+
+// Fails unless the time in column 0 is within the documented bound and, with `strict`, after the
+// previous row's (else not before it).
+void CheckTime(const CsvRows& csv, size_t row, bool strict) {
+  csv.Bounded(row, 0, kMaxDataTime, "the time t", "s");
+  if (row == 0) return;
+  const double t = csv.rows[row][0], previous = csv.rows[row - 1][0];
+  if (strict ? !(t > previous) : t < previous) {
+    csv.Fail(row, 1, fmt::format("times must {}: {} after {}", strict ? "increase" : "not decrease", t, previous));
+  }
 }
 
 }  // namespace
@@ -115,33 +169,48 @@ QuadrotorData ReadQuadrotorData(const std::string& folder) {
   if (!std::filesystem::is_directory(dir)) throw InputError(folder, 0, 0, "not a folder (expected a quadrotor data folder)");
   QuadrotorData data;
   data.vehicle = ReadVehicle((dir / "vehicle.json").string());
-  for (const auto& row : ReadCsv(dir / "landmarks.csv", 4)) {
-    if (row[0] != static_cast<double>(data.landmarks.size())) {
-      throw InputError((dir / "landmarks.csv").string(), static_cast<int64_t>(data.landmarks.size()) + 2, 1,
-                       "landmark ids must be 0, 1, 2, ... in order");
+  const CsvRows landmarks = ReadCsv(dir / "landmarks.csv", 4);
+  for (size_t i = 0; i < landmarks.rows.size(); ++i) {
+    const std::vector<double>& row = landmarks.rows[i];
+    if (row[0] != static_cast<double>(i)) {
+      landmarks.Fail(i, 1, fmt::format("expected landmark id {} (ids are 0, 1, 2, ... in order), got {}", i, row[0]));
     }
+    for (size_t c = 1; c <= 3; ++c) landmarks.Bounded(i, c, kMaxDataCoordinate, "a landmark coordinate", "m");
     data.landmarks.emplace_back(row[1], row[2], row[3]);
   }
-  int64_t line = 1;
-  for (const auto& row : ReadCsv(dir / "measurements.csv", 4)) {
-    ++line;
-    const int id = static_cast<int>(row[1]);
-    if (row[1] != id || id < 0 || id >= static_cast<int>(data.landmarks.size())) {
-      throw InputError((dir / "measurements.csv").string(), line, 1, fmt::format("unknown landmark id {}", row[1]));
+  const CsvRows measurements = ReadCsv(dir / "measurements.csv", 4);
+  for (size_t i = 0; i < measurements.rows.size(); ++i) {
+    const std::vector<double>& row = measurements.rows[i];
+    CheckTime(measurements, i, false);
+    if (!(row[1] >= 0 && row[1] < static_cast<double>(data.landmarks.size()) && row[1] == std::floor(row[1]))) {
+      measurements.Fail(i, 1, fmt::format("unknown landmark id {} (landmarks.csv has ids 0 to {})", row[1],
+                                          static_cast<int64_t>(data.landmarks.size()) - 1));
     }
-    if (!data.pixels.empty() && row[0] < data.pixels.back().t) {
-      throw InputError((dir / "measurements.csv").string(), line, 1, "measurement times must not decrease");
-    }
-    data.pixels.push_back({row[0], id, Eigen::Vector2d(row[2], row[3])});
+    measurements.Bounded(i, 2, kMaxDataPixel, "the pixel u", "px");
+    measurements.Bounded(i, 3, kMaxDataPixel, "the pixel v", "px");
+    data.pixels.push_back({row[0], static_cast<int>(row[1]), Eigen::Vector2d(row[2], row[3])});
   }
-  for (const auto& row : ReadCsv(dir / "initial.csv", 8)) {
-    data.initial.push_back({row[0], Eigen::Vector3d(row[1], row[2], row[3]),
-                            Eigen::Quaterniond(row[4], row[5], row[6], row[7]).normalized()});
+  const CsvRows initial = ReadCsv(dir / "initial.csv", 8);
+  for (size_t i = 0; i < initial.rows.size(); ++i) {
+    const std::vector<double>& row = initial.rows[i];
+    CheckTime(initial, i, true);
+    for (size_t c = 1; c <= 3; ++c) initial.Bounded(i, c, kMaxDataCoordinate, "a position coordinate", "m");
+    data.initial.push_back({row[0], Eigen::Vector3d(row[1], row[2], row[3]), RowQuaternion(initial, i, 4)});
   }
-  if (data.initial.size() < 2) throw InputError((dir / "initial.csv").string(), 0, 0, "needs at least 2 poses");
+  if (data.initial.size() < 2) throw InputError(initial.path, 0, 0, "needs at least 2 poses");
   if (std::filesystem::exists(dir / "truth.csv")) {
-    for (const auto& r : ReadCsv(dir / "truth.csv", 18)) {
-      data.truth.push_back({r[0], Eigen::Vector3d(r[1], r[2], r[3]), Eigen::Quaterniond(r[4], r[5], r[6], r[7]).normalized(),
+    const CsvRows truth = ReadCsv(dir / "truth.csv", 18);
+    for (size_t i = 0; i < truth.rows.size(); ++i) {
+      const std::vector<double>& r = truth.rows[i];
+      CheckTime(truth, i, true);
+      for (size_t c = 1; c <= 3; ++c) truth.Bounded(i, c, kMaxDataCoordinate, "a position coordinate", "m");
+      for (size_t c = 8; c <= 13; ++c) truth.Bounded(i, c, kMaxDataRate, "a velocity or body rate", "m/s or rad/s");
+      for (size_t c = 14; c <= 17; ++c) {
+        if (!(r[c] >= 0 && r[c] <= kMaxDataRate)) {
+          truth.Fail(i, 0, fmt::format("a rotor speed must be within [0, {:g}] rad/s, got {}", kMaxDataRate, r[c]));
+        }
+      }
+      data.truth.push_back({r[0], Eigen::Vector3d(r[1], r[2], r[3]), RowQuaternion(truth, i, 4),
                             Eigen::Vector3d(r[8], r[9], r[10]), Eigen::Vector3d(r[11], r[12], r[13]),
                             Eigen::Vector4d(r[14], r[15], r[16], r[17])});
     }

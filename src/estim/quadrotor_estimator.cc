@@ -194,8 +194,8 @@ std::pair<double, double> MeasurementSpan(const std::vector<Eigen::Vector3d>& la
 }
 
 // round((t1 − t0) / segment_s) equal segments (at least one).
-std::vector<double> Breakpoints(double t0, double t1, double segment_s) {
-  const int segments = std::max(1, static_cast<int>(std::lround((t1 - t0) / segment_s)));
+std::vector<double> Breakpoints(double t0, double t1, double segment_s, int degree) {
+  const int segments = SegmentCount("QuadrotorEstimateOptions", t1 - t0, segment_s, degree);
   std::vector<double> breakpoints(segments + 1);
   for (int s = 0; s <= segments; ++s) breakpoints[s] = t0 + (t1 - t0) * s / segments;
   breakpoints.back() = t1;
@@ -317,7 +317,8 @@ QuadrotorEstimate EstimateQuadrotor(const Vehicle& vehicle, const std::vector<Ei
   const auto start = std::chrono::steady_clock::now();
   options.Validate();
   const auto [t0, t1] = MeasurementSpan(landmarks, pixels, initial);
-  Problem problem(QuadrotorModel{vehicle.quadrotor}, Breakpoints(t0, t1, options.segment_s), options.degree);
+  Problem problem(QuadrotorModel{vehicle.quadrotor}, Breakpoints(t0, t1, options.segment_s, options.degree),
+                  options.degree);
   SetInitialValues(problem, vehicle.quadrotor, initial, options.initial_window_s);
   problem.AddCollocation(CollocationSigma(options));
   problem.AddControlSmoothnessPrior(1, options.sigma_rotor_rate, RotorBasis());

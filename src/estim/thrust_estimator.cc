@@ -18,9 +18,11 @@
 #include <ceres/ceres.h>
 
 #include "cheval/common/error.h"
+#include "cheval/common/input_file.h"
 #include "cheval/common/random.h"
 #include "cheval/common/options.h"
 #include "cheval/estim/problem.h"
+#include "cheval/estim/quadrotor_data.h"
 
 namespace cheval::estim {
 namespace {
@@ -36,20 +38,22 @@ struct CsvTable {
 };
 
 CsvTable ReadNumericCsv(const std::string& path, const std::vector<std::string_view>& header) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, 0, 0, "cannot open");
+  const std::string content = ReadInputFile(path, kMaxDataFileBytes, "a DIDO CSV file");
   CsvTable table;
-  std::string line;
   int64_t number = 0;
   bool seen_header = false;
-  while (std::getline(in, line)) {
+  for (size_t at = 0; at < content.size();) {
+    const size_t newline = content.find('\n', at);
+    const size_t line_end = newline == std::string::npos ? content.size() : newline;
+    std::string_view line(content.data() + at, line_end - at);
+    at = line_end + 1;
     ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (line.empty()) continue;
     // Split at commas, remembering each field's 1-based column.
     std::vector<std::pair<std::string_view, int64_t>> fields;
-    const std::string_view text(line);
-    size_t start = 0;
+    const std::string_view text = line;
+    size_t start = 0;  // of the field
     while (true) {
       const size_t comma = text.find(',', start);
       const size_t stop = comma == std::string_view::npos ? text.size() : comma;
@@ -61,10 +65,12 @@ CsvTable ReadNumericCsv(const std::string& path, const std::vector<std::string_v
       for (size_t i = 0; i < std::max(fields.size(), header.size()); ++i) {
         if (i >= fields.size() || i >= header.size() || fields[i].first != header[i]) {
           const int64_t column = i < fields.size() ? fields[i].second : static_cast<int64_t>(line.size()) + 1;
+          std::string got = i < fields.size() ? std::string(fields[i].first.substr(0, 40)) : "(end of line)";
+          for (char& c : got) c = (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) ? '?' : c;
           throw InputError(path, number, column,
                            fmt::format("expected the header column '{}', got '{}'",
                                        i < header.size() ? std::string(header[i]) : std::string("(end of line)"),
-                                       i < fields.size() ? std::string(fields[i].first) : std::string("(end of line)")));
+                                       got));
         }
       }
       seen_header = true;
@@ -78,8 +84,11 @@ CsvTable ReadNumericCsv(const std::string& path, const std::vector<std::string_v
       const std::string_view f = fields[i].first;
       const auto [end, ec] = std::from_chars(f.data(), f.data() + f.size(), row[i]);
       if (f.empty() || ec != std::errc() || end != f.data() + f.size() || !std::isfinite(row[i])) {
+        std::string got(f.substr(0, 40));
+        for (char& c : got) c = (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) ? '?' : c;
         throw InputError(path, number, fields[i].second,
-                         fmt::format("expected a finite number for {}, got '{}'", header[i], f));
+                         fmt::format("expected a finite number for {}, got '{}{}'", header[i], got,
+                                     f.size() > 40 ? "..." : ""));
       }
     }
     table.rows.push_back(std::move(row));
@@ -196,6 +205,18 @@ std::vector<ThrustSample> ReadDidoCsv(const std::string& path) {
     s.t = r[0];
     if (!out.empty() && !(s.t > out.back().t)) {
       throw InputError(path, line, 1, fmt::format("time stamps must increase: {:.6f} after {:.6f}", s.t, out.back().t));
+    }
+    // Bounds of docs/estimator.md ("Limits"): every value of a DIDO row within 1e6 of 0 (the
+    // time within kMaxDataTime), so nothing computed from them overflows.
+    if (!(std::abs(s.t) <= kMaxDataTime)) {
+      throw InputError(path, line, 1,
+                       fmt::format("t_s must be within [-{:g}, {:g}] s, got {}", kMaxDataTime, kMaxDataTime, s.t));
+    }
+    for (size_t c = 1; c < r.size(); ++c) {
+      if (!(std::abs(r[c]) <= kMaxDataRate)) {
+        throw InputError(path, line, 1, fmt::format("{} must be within [-{:g}, {:g}], got {}", kHeader[c], kMaxDataRate,
+                                                    kMaxDataRate, r[c]));
+      }
     }
     s.p = Eigen::Vector3d(r[1], r[2], r[3]);
     const Eigen::Quaterniond q(r[4], r[5], r[6], r[7]);
@@ -333,7 +354,7 @@ ThrustEstimate EstimateThrust(const ThrustFlight& flight, const ThrustEstimateOp
 
   // The problem over [0, T].
   const double T = t.back();
-  const int segments = std::max(1, static_cast<int>(std::lround(T / options.segment_s)));
+  const int segments = SegmentCount("ThrustEstimateOptions", T, options.segment_s, options.degree);
   std::vector<double> breakpoints(segments + 1);
   for (int s = 0; s <= segments; ++s) breakpoints[s] = T * s / segments;
   using Problem = PseudoSpectralProblem<ThrustModel>;
@@ -409,11 +430,28 @@ ThrustEstimate EstimateThrust(const ThrustFlight& flight, const ThrustEstimateOp
   double sum = 0;
   for (double r : measured_rpm) sum += r;
   out.mean_measured_rpm = sum / n;
+  if (!(out.mean_measured_rpm > 0)) {
+    throw ComputeError(fmt::format("{}: the measured rotor speeds (rpm_1 to rpm_4) are 0 at every sample: the "
+                                   "collective error relative to them is undefined (the log holds no flight)",
+                                   flight.name));
+  }
   out.position_rmse_m = std::sqrt(position_sq / n);
   out.velocity_rmse_mps = std::sqrt(velocity_sq / n);
   out.t = t;
   out.estimated_rpm = std::move(estimated);
   out.measured_rpm = std::move(measured_rpm);
+  for (const CollectiveErrors* e : {&out.estimate, &out.flatness, &out.accelerometer, &out.model_floor}) {
+    if (!std::isfinite(e->mean_abs_rpm) || !std::isfinite(e->mean_abs_percent) || !std::isfinite(e->rmse_rpm) ||
+        !std::isfinite(e->bias_rpm)) {
+      throw ComputeError(fmt::format("{}: a collective error is not finite (mean {} rpm, {} %): the estimate or a "
+                                     "baseline diverged",
+                                     flight.name, e->mean_abs_rpm, e->mean_abs_percent));
+    }
+  }
+  if (!std::isfinite(out.position_rmse_m) || !std::isfinite(out.velocity_rmse_mps)) {
+    throw ComputeError(fmt::format("{}: the estimated positions or velocities are not finite (RMSE {} m, {} m/s)",
+                                   flight.name, out.position_rmse_m, out.velocity_rmse_mps));
+  }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }

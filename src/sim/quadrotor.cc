@@ -304,11 +304,35 @@ void QuadrotorSimOptions::Validate() const {
   non_negative(vo_rotation_noise_rad, "vo_rotation_noise_rad");
   non_negative(vo_position_drift_m_per_sqrt_s, "vo_position_drift_m_per_sqrt_s");
   non_negative(vo_rotation_drift_rad_per_sqrt_s, "vo_rotation_drift_rad_per_sqrt_s");
+  const double truth_bytes = (std::floor(duration_s * truth_rate_hz) + 1) * kTruthSampleBytes;
+  check(truth_bytes <= kMaxQuadrotorSimBytes, "truth_rate_hz",
+        "must keep the truth within {:.0f} GB; {} Hz over {} s is {:.4g} samples, about {:.3g} GB",
+        kMaxQuadrotorSimBytes / 1e9, truth_rate_hz, duration_s, std::floor(duration_s * truth_rate_hz) + 1,
+        truth_bytes / 1e9);
+  const double landmark_bytes = static_cast<double>(landmarks) * kLandmarkBytes;
+  check(landmark_bytes <= kMaxQuadrotorSimBytes, "landmarks",
+        "must keep the landmarks within {:.0f} GB; {} is about {:.3g} GB", kMaxQuadrotorSimBytes / 1e9, landmarks,
+        landmark_bytes / 1e9);
+}
+
+double QuadrotorSimBytes(const estim::Vehicle& vehicle, const QuadrotorSimOptions& options) {
+  const double frames = std::floor(options.duration_s * vehicle.camera.rate_hz) + 1;
+  const double features = std::min(options.max_features_per_frame, options.landmarks);
+  return (std::floor(options.duration_s * options.truth_rate_hz) + 1) * kTruthSampleBytes +
+         static_cast<double>(options.landmarks) * kLandmarkBytes + frames * (kFrameBytes + features * kPixelBytes);
 }
 
 estim::QuadrotorData SimulateQuadrotor(const estim::Vehicle& vehicle, const QuadrotorSimOptions& options) {
   options.Validate();
   estim::ValidateVehicle(vehicle, "<vehicle>");
+  if (const double bytes = QuadrotorSimBytes(vehicle, options); !(bytes <= kMaxQuadrotorSimBytes)) {
+    throw ComputeError(fmt::format(
+        "the simulation would need about {:.3g} GB, above the limit of {:.0f} GB: {} s at the vehicle's camera.rate_hz "
+        "{} Hz is {:.4g} frames of up to {} features each; shorten the duration or lower camera.rate_hz",
+        bytes / 1e9, kMaxQuadrotorSimBytes / 1e9, options.duration_s, vehicle.camera.rate_hz,
+        std::floor(options.duration_s * vehicle.camera.rate_hz) + 1,
+        std::min(options.max_features_per_frame, options.landmarks)));
+  }
   estim::QuadrotorData data;
   data.vehicle = vehicle;
   Random landmark_random = SimulatorRandom(options.seed, 1), pixel_random = SimulatorRandom(options.seed, 2),

@@ -209,7 +209,7 @@ TEST_F(CompressCliTest, BadInputHasItsExitCodeAndLeavesNoFile) {
   const RunResult version = Cheval("sample " + Path("model.json") + " --rate 5 -o " + Path("s.txt"));
   EXPECT_EQ(version.exit_code, 2);
   EXPECT_EQ(version.err,
-            Path("model.json") + ":0:0: error: version: expected 1 (the version this cheval reads), got 7\n");
+            Path("model.json") + ":0:0: error: version: expected 1 or 2 (the versions this cheval reads), got 7\n");
   std::ofstream(Path("broken.json")) << "{\"format\": \n";
   const RunResult broken = Cheval("sample " + Path("broken.json") + " --rate 5 -o " + Path("s.txt"));
   EXPECT_EQ(broken.exit_code, 2);

@@ -88,7 +88,7 @@ TEST_F(CliTest, EstimateThrustOnASimulatedDidoFile) {
 TEST_F(CliTest, EstimateThrustBadInput) {
   RunResult missing = Cheval("estimate thrust --data " + Path("none.csv"));
   EXPECT_EQ(missing.exit_code, 2);
-  EXPECT_EQ(missing.err, Path("none.csv") + ":0:0: error: cannot open\n");
+  EXPECT_EQ(missing.err, Path("none.csv") + ":0:0: error: cannot open file: No such file or directory\n");
   std::ofstream(Path("bad.csv")) << "t_s,p_x,p_y,pz\n";
   RunResult header = Cheval("estimate thrust --data " + Path("bad.csv"));
   EXPECT_EQ(header.exit_code, 2);
@@ -96,7 +96,7 @@ TEST_F(CliTest, EstimateThrustBadInput) {
   WriteSimulatedDido(Path("f.csv"), Path("f.dynamic_params.csv"));
   RunResult params = Cheval("estimate thrust --data " + Path("f.csv") + " --params " + Path("nope.csv"));
   EXPECT_EQ(params.exit_code, 2);
-  EXPECT_EQ(params.err, Path("nope.csv") + ":0:0: error: cannot open\n");
+  EXPECT_EQ(params.err, Path("nope.csv") + ":0:0: error: cannot open file: No such file or directory\n");
   RunResult degree = Cheval("estimate thrust --degree 1 --data " + Path("f.csv"));
   EXPECT_EQ(degree.exit_code, 1);
   EXPECT_EQ(degree.err, "cheval: error: --degree must be in [2, 64], got 1\n");

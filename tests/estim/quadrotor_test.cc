@@ -85,14 +85,104 @@ class VehicleFileTest : public ::testing::Test {
 };
 
 TEST_F(VehicleFileTest, NonPhysicalOrMissingValuesAreErrors) {
-  ExpectError(Shipped("\"mass_kg\": 1.0", "\"mass_kg\": -1.0"), "\"mass_kg\" must be a finite number > 0, got -1");
+  ExpectError(Shipped("\"mass_kg\": 1.0", "\"mass_kg\": -1.0"), "\"mass_kg\" must be a finite number > 0 and <= 10000, got -1");
   ExpectError(Shipped("[0.0049, 0.0049, 0.0069]", "[0.0049, 0, 0.0069]"), "singular or negative inertia");
   ExpectError(Shipped("[0.0049, 0.0049, 0.0069]", "[0.001, 0.001, 0.01]"), "triangle inequality");
   ExpectError(Shipped("\"mass_kg\": 1.0,", ""), "missing key \"mass_kg\"");
   ExpectError(Shipped("\"fx\": 400", "\"fx\": \"400\""), "\"camera.fx\" must be a number");
   ExpectError(Shipped("\"max_rotor_speed_radps\": 2200", "\"max_rotor_speed_radps\": 1000"), "cannot fly");
-  ExpectError("{ not json", "not valid JSON");
+  ExpectError("{ not json", "expected JSON (a vehicle file)");
   EXPECT_THROW(estim::ReadVehicle("/nonexistent/vehicle.json"), InputError);
+}
+
+// A number beyond a double is an InputError naming the key that holds it (nlohmann's out_of_range
+// escaped as an internal error, exit 70, before).
+TEST_F(VehicleFileTest, NumberOverflowNamesTheKey) {
+  ExpectError(Shipped("\"mass_kg\": 1.0", "\"mass_kg\": 1e400"),
+              ":0:0: error: mass_kg: the number '1e400' is too large for a double (at most 1.8e308 in magnitude)");
+  ExpectError(Shipped("\"rate_hz\": 30", "\"rate_hz\": -1e400"), "error: camera.rate_hz: the number '-1e400' is too large");
+  ExpectError(Shipped("[0.0049, 0.0049, 0.0069]", "[0.0049, 1e999, 0.0069]"), "error: inertia_kgm2[1]: the number '1e999'");
+}
+
+// Every value within its documented range (docs/estimator.md, "Vehicle file"), so nothing computed
+// from it overflows; the camera rate bounds the simulator's frames.
+TEST_F(VehicleFileTest, ValuesOutsideTheirRangeAreErrors) {
+  ExpectError(Shipped("\"mass_kg\": 1.0", "\"mass_kg\": 1e300"),
+              "\"mass_kg\" must be a finite number > 0 and <= 10000, got 1e+300");
+  ExpectError(Shipped("\"rate_hz\": 30", "\"rate_hz\": 1e6"),
+              "\"camera.rate_hz\" must be a finite number > 0 and <= 1000, got 1000000");
+  ExpectError(Shipped("\"width\": 640", "\"width\": 1e10"), "\"camera.width\" must be an integer in [1, 100000], got 10000000000");
+  ExpectError(Shipped("\"height\": 480", "\"height\": 480.5"), "\"camera.height\" must be an integer in [1, 100000], got 480.5");
+  ExpectError(Shipped("\"cx\": 320", "\"cx\": 1e300"), "\"camera.cx\" must be a finite number in [-1000000, 1000000], got 1e+300");
+  ExpectError(Shipped("\"gravity_mps2\": 9.81", "\"gravity_mps2\": 1e200"), "\"gravity_mps2\" must be a finite number > 0 and <= 100");
+  ExpectError(Shipped("\"drag_coefficient\": 0.1", "\"drag_coefficient\": 0.1, \"grav\": 9"),
+              "unknown key \"grav\"; expected only name, source,");
+  ExpectError(Shipped("\"fx\": 400", "\"fx\": 400, \"rate\": 30"), "unknown key \"camera.rate\"");
+}
+
+TEST_F(VehicleFileTest, ADirectoryIsAnInputError) {
+  const fs::path dir = fs::temp_directory_path() / ("cheval_vehicle_dir_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  try {
+    estim::ReadVehicle(dir.string());
+    ADD_FAILURE() << "a directory was read as a vehicle";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), dir.string() + ":0:0: error: is a directory; expected a vehicle JSON file");
+  }
+  fs::remove_all(dir);
+}
+
+// The estimator refuses a segment length whose problem would not fit in memory before allocating
+// it (--segment 1e-9 took 15.6 GB and ended in exit 70; the segment count overflowed an int).
+TEST(QuadrotorEstimator, RefusesASegmentLengthBeyondTheMemoryLimit) {
+  const estim::Vehicle vehicle = estim::ReadVehicle(kVehicle);
+  sim::QuadrotorSimOptions sim_options;
+  sim_options.duration_s = 1.0;
+  const estim::QuadrotorData data = sim::SimulateQuadrotor(vehicle, sim_options);
+  for (double segment : {1e-9, 1e-5}) {
+    estim::QuadrotorEstimateOptions options;
+    options.segment_s = segment;
+    try {
+      estim::EstimateQuadrotor(vehicle, data.landmarks, data.pixels, data.initial, options, {});
+      ADD_FAILURE() << "segment " << segment << " accepted";
+    } catch (const OptionError& e) {
+      EXPECT_EQ(e.field(), "segment_s");
+      EXPECT_NE(e.rule().find("must keep the problem within 3 GB"), std::string::npos) << e.what();
+      EXPECT_NE(e.rule().find(" GB (16 KB + 6 KB x degree per node)"), std::string::npos) << e.what();
+    }
+  }
+}
+
+// The simulator's memory is bounded: truth samples and landmarks by Validate (OptionError), the
+// camera's frames (duration x camera.rate_hz) by a ComputeError naming the vehicle's key.
+TEST(QuadrotorSim, RefusesARunBeyondTheMemoryLimit) {
+  estim::Vehicle vehicle = estim::ReadVehicle(kVehicle);
+  const auto refused_field = [](const sim::QuadrotorSimOptions& o) {
+    try {
+      o.Validate();
+    } catch (const OptionError& e) {
+      return e.field();
+    }
+    return std::string("(accepted)");
+  };
+  sim::QuadrotorSimOptions options;
+  options.duration_s = 3600;
+  options.integration_rate_hz = 1e5;
+  options.truth_rate_hz = 1e5;
+  EXPECT_EQ(refused_field(options), "truth_rate_hz");  // 3.6e8 truth samples
+  options = {};
+  options.landmarks = 2'000'000'000;
+  EXPECT_EQ(refused_field(options), "landmarks");
+  options = {};
+  options.duration_s = 3600;
+  vehicle.camera.rate_hz = 1000;
+  EXPECT_GT(sim::QuadrotorSimBytes(vehicle, options), sim::kMaxQuadrotorSimBytes);
+  try {
+    sim::SimulateQuadrotor(vehicle, options);
+    ADD_FAILURE() << "3.6e6 frames accepted";
+  } catch (const ComputeError& e) {
+    EXPECT_NE(std::string(e.what()).find("camera.rate_hz 1000 Hz is 3.6e+06 frames"), std::string::npos) << e.what();
+  }
 }
 
 // The simulator integrates the estimator's own model: the truth samples satisfy v = dp/dt to the

@@ -153,6 +153,37 @@ TEST(ThrustEstimator, RejectsBadOptions) {
   EXPECT_THROW(estim::EstimateThrust(flight, o), UsageError);
 }
 
+// A segment length whose problem would not fit in memory is refused before allocating
+// (--segment 1e-6 ended in std::bad_alloc, exit 70).
+TEST(ThrustEstimator, RefusesASegmentLengthBeyondTheMemoryLimit) {
+  const estim::ThrustFlight flight = SimulatedFlight(sim::QuadrotorScenario::kHover, 1.0);
+  estim::ThrustEstimateOptions o;
+  o.segment_s = 1e-6;
+  try {
+    estim::EstimateThrust(flight, o);
+    ADD_FAILURE() << "no error";
+  } catch (const OptionError& e) {
+    EXPECT_EQ(e.field(), "segment_s");
+    EXPECT_NE(e.rule().find("must keep the problem within 3 GB; 1e-06 s gives 1e+06 segments of degree 10"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// A log whose rotor speeds are all 0 has no relative error: a ComputeError, not "inf %" (exit 0).
+TEST(ThrustEstimator, AllZeroRotorSpeedsAreAComputeError) {
+  estim::ThrustFlight flight = SimulatedFlight(sim::QuadrotorScenario::kHover, 1.0);
+  for (estim::ThrustSample& s : flight.samples) s.rotor.setZero();
+  try {
+    estim::EstimateThrust(flight, {});
+    ADD_FAILURE() << "no error";
+  } catch (const ComputeError& e) {
+    EXPECT_NE(std::string(e.what()).find("the measured rotor speeds (rpm_1 to rpm_4) are 0 at every sample"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // The DIDO readers: every bad input names file, line and column.
 
@@ -215,6 +246,16 @@ TEST_F(DidoReader, BadCsvMessages) {
   EXPECT_EQ(CsvError(h + kRow1 + "\n"), ":0:0: error: needs at least 2 samples");
   EXPECT_EQ(CsvError(""), ":0:0: error: empty file (expected a header line)");
   EXPECT_THROW(estim::ReadDidoCsv((dir_ / "missing.csv").string()), InputError);
+  std::string huge = kRow1;
+  huge.replace(huge.find(",0,0,1,"), 7, ",0,1e300,1,");
+  EXPECT_EQ(CsvError(h + huge + "\n" + kRow2 + "\n"), ":2:1: error: p_y must be within [-1e+06, 1e+06], got 1e+300");
+  fs::create_directories(dir_ / "folder.csv");
+  try {
+    estim::ReadDidoCsv((dir_ / "folder.csv").string());
+    ADD_FAILURE() << "a directory was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("folder.csv:0:0: error: is a directory"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(DidoReader, ParametersInSiUnits) {

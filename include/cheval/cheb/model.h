@@ -90,6 +90,14 @@ Eigen::Index ModelValueCount(const TrajectoryModel& model);
 /// value arrays. This is the denominator of the compression ratio (compress.h).
 Eigen::Index ModelNumberCount(const TrajectoryModel& model);
 
+/// The FNV-1a 64-bit hash of the model's content in a fixed order (docs/compress.md, "Checksum"):
+/// dimension, origin, the diagnostics (with their lengths and whether present), then per segment
+/// its stamps and window count, per window its four interval ends and per coordinate the number of
+/// values and their IEEE-754 bit patterns; every item as 8 bytes, least significant first. Equal
+/// for two models exactly when (but for hash collisions) every stored number is bit-identical, so
+/// reformatting the JSON keeps it and changing any number changes it.
+uint64_t ModelChecksum(const TrajectoryModel& model);
+
 /// ReconstructionError of `curve` at samples `values` (m x d) taken at `stamps_ns` (any order).
 /// Throws ComputeError when a stamp lies outside the curve (outside its data or in a gap).
 ReconstructionError MeasureReconstruction(const Curve& curve, std::span<const int64_t> stamps_ns,
@@ -106,9 +114,10 @@ void CheckModelCovers(const TrajectoryModel& model, std::span<const int64_t> sta
 /// the grid has at most 1e8 stamps over the model's span.
 std::vector<int64_t> ModelGridStamps(const TrajectoryModel& model, double rate_hz);
 
-/// The model as JSON text (docs/compress.md): `"format": "cheval-trajectory-model"`, `"version": 1`.
-/// Every double is written in the shortest form that reads back to the same double, stamps as
-/// integers, so ParseModelJson(WriteModelJson(m)) evaluates bit-identically to m.
+/// The model as JSON text (docs/compress.md): `"format": "cheval-trajectory-model"`, `"version": 2`,
+/// and last `"checksum": "fnv1a64:<16 hex digits>"` (ModelChecksum). Every double is written in the
+/// shortest form that reads back to the same double, stamps as integers, so
+/// ParseModelJson(WriteModelJson(m)) evaluates bit-identically to m.
 std::string WriteModelJson(const TrajectoryModel& model);
 
 /// Parses and validates a model. Throws InputError (`path:LINE:COLUMN` for invalid JSON, else
@@ -116,7 +125,10 @@ std::string WriteModelJson(const TrajectoryModel& model);
 /// `segments[0].windows[2].values[1]: expected an array of finite numbers, got "x"`, for
 /// anything that would not give a valid curve: wrong format or version, unknown or missing keys,
 /// non-finite numbers, empty arrays, unordered segments, windows that do not tile their segment or
-/// whose fit interval does not contain their core, value arrays per window other than `dimension`.
+/// whose fit interval does not contain their core, value arrays per window other than `dimension`;
+/// for version 2 (what WriteModelJson writes) a missing checksum or one that differs from
+/// ModelChecksum of the numbers read ("checksum: checksum mismatch: ..."). Version 1 (written
+/// before the checksum existed) is read without one, with every structural check above.
 TrajectoryModel ParseModelJson(std::string_view text, const std::string& path);
 
 /// Reads and parses a model file (InputError when it cannot be opened or is invalid). Write one

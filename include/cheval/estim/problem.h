@@ -26,6 +26,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -448,5 +449,31 @@ class PseudoSpectralProblem {
   std::map<int, SmoothnessPrior> smoothness_;
   std::unique_ptr<ceres::Problem> problem_;  // last: destroyed first, before the manifolds it uses
 };
+
+/// The most memory an estimator's problem may take, bytes, as estimated by ProblemBytes.
+inline constexpr double kMaxProblemBytes = 3e9;
+
+/// The memory a problem of `nodes` Chebyshev nodes of `degree` takes, bytes: 16 KB + 6 KB x degree
+/// per node, the peak measured for the quadrotor estimator (docs/estimator.md, "Limits": 40 KB per
+/// node at degree 4, 390 KB at degree 64; the thrust estimator takes less).
+inline double ProblemBytes(double nodes, int degree) { return nodes * (16e3 + 6e3 * degree); }
+
+/// round(span_s / segment_s) (at least 1): the number of equal segments an estimator cuts its span
+/// into. Throws OptionError(options, "segment_s", ...) naming the node count it would give
+/// (segments · degree + 1), its memory and the limit when ProblemBytes exceeds kMaxProblemBytes,
+/// before anything is allocated.
+inline int SegmentCount(const std::string& options, double span_s, double segment_s, int degree) {
+  const double segments = std::max(1.0, std::round(span_s / segment_s));
+  const double nodes = segments * degree + 1.0;
+  if (!(ProblemBytes(nodes, degree) <= kMaxProblemBytes)) {
+    throw OptionError(options, "segment_s",
+                      fmt::format("must keep the problem within {:.0f} GB; {} s gives {:.4g} segments of degree {} "
+                                  "over the {:.6g} s span = {:.4g} nodes, about {:.3g} GB (16 KB + 6 KB x degree per "
+                                  "node)",
+                                  kMaxProblemBytes / 1e9, segment_s, segments, degree, span_s, nodes,
+                                  ProblemBytes(nodes, degree) / 1e9));
+  }
+  return static_cast<int>(segments);
+}
 
 }  // namespace cheval::estim

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -20,6 +21,14 @@ namespace cheval::estim {
 /// The files of a data folder, in the order WriteQuadrotorData writes them (truth.csv is optional).
 inline constexpr std::array<std::string_view, 5> kQuadrotorDataFiles = {"vehicle.json", "landmarks.csv",
                                                                      "measurements.csv", "initial.csv", "truth.csv"};
+
+/// Bounds of a data folder's values (docs/estimator.md, "Data folder"): beyond them a value is an
+/// InputError naming the file and line. Each CSV file is at most kMaxDataFileBytes bytes.
+inline constexpr uint64_t kMaxDataFileBytes = uint64_t{1} << 30;
+inline constexpr double kMaxDataTime = 1e10;        ///< |t|, s (epoch seconds fit)
+inline constexpr double kMaxDataCoordinate = 1e6;   ///< |x|, |y|, |z| of landmarks and positions, m
+inline constexpr double kMaxDataPixel = 1e6;        ///< |u|, |v|, px
+inline constexpr double kMaxDataRate = 1e6;         ///< truth.csv: |velocity|, |body rate| per axis; rotor speed
 
 /// The state of the vehicle at one time, as truth.csv holds it: the exact state in a simulated
 /// folder, an estimate's state when EstimatedStates (quadrotor_scoring.h) converts one.
@@ -56,8 +65,13 @@ std::string QuadrotorStatesCsv(const std::vector<QuadrotorTruth>& states);
 /// files are never deleted. OutputError when the folder cannot be written or is refused.
 void WriteQuadrotorData(const QuadrotorData& data, const std::string& folder);
 
-/// Reads a data folder. truth.csv is optional; every other file is required. InputError naming
-/// the missing or malformed file (and line).
+/// Reads a data folder. truth.csv is optional; every other file is required. Lines end in LF or
+/// CRLF; a first line that does not start with a number is a header. InputError `FILE:LINE:COLUMN:
+/// error: ...` for a missing, unreadable or too large file, a path that is a directory, a row without
+/// exactly the file's columns of finite numbers, a value beyond the bounds above, landmark ids not
+/// 0, 1, 2, ..., a measurement of an unknown landmark, measurement times that decrease, initial or
+/// truth times that do not increase, a zero (or overflowing) quaternion, a negative rotor speed, or
+/// fewer than 2 initial poses.
 QuadrotorData ReadQuadrotorData(const std::string& folder);
 
 }  // namespace cheval::estim

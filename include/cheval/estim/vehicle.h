@@ -12,6 +12,10 @@
 
 namespace cheval::estim {
 
+/// The highest camera rate a vehicle file may give (`camera.rate_hz`), Hz: the simulator makes one
+/// frame per period, and faster cameras than this do not fly on quadrotors.
+inline constexpr double kMaxCameraRateHz = 1000.0;
+
 /// A pinhole camera rigidly mounted on the body, looking forward: optical axis z_c = body x,
 /// x_c = −body y (image right), y_c = −body z (image down); optical centre at the body origin.
 /// Pixel (u, v) = (fx X/Z + cx, fy Y/Z + cy) for a point (X, Y, Z) in the camera frame, Z > 0.
@@ -32,11 +36,13 @@ struct Vehicle {
   PinholeCamera camera;
 };
 
-/// Reads and validates a vehicle JSON file. Throws InputError (`path:0:0: error: ...`) when the file
-/// cannot be read or parsed, a key is missing or not a number, or a value is not physical: mass,
-/// inertia entries, arm, k_F, motor time constant, rotor speed limit and intrinsics must be finite
-/// and > 0, k_M and drag >= 0, the inertia must satisfy the triangle inequalities of a rigid body
-/// (J_x + J_y >= J_z, ...), and the hover speed must be below the rotor speed limit.
+/// Reads and validates a vehicle JSON file (at most 1 MiB). Throws InputError (`path:0:0: error:
+/// ...`) when the path is a directory, the file cannot be read or parsed, a number is beyond a double
+/// (naming its key), a key is unknown, missing or not a number, or a value is outside its documented
+/// range (docs/estimator.md, "Vehicle file": e.g. mass in (0, 1e4] kg, camera.rate_hz in (0, 1000],
+/// camera.width and height integers in [1, 1e5]); the inertia must satisfy the triangle
+/// inequalities of a rigid body (J_x + J_y >= J_z, ...), and the hover speed must be below the rotor
+/// speed limit.
 Vehicle ReadVehicle(const std::string& path);
 
 /// Validates a vehicle built in code; throws InputError with `path` as the location (may be

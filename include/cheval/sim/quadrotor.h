@@ -46,12 +46,25 @@ struct QuadrotorSimOptions {
 
   /// Throws OptionError naming the first field out of range: duration_s in (0, 3600],
   /// integration_rate_hz in [100, 1e5], truth_rate_hz in (0, integration_rate_hz], landmarks and
-  /// max_features_per_frame > 0, the four front-end noise and drift levels finite and >= 0.
+  /// max_features_per_frame > 0, the four front-end noise and drift levels finite and >= 0; the truth
+  /// samples and the landmarks each within kMaxQuadrotorSimBytes (below).
   void Validate() const;
 };
 
+/// The most memory a simulation may take (its data and the text of its data folder), bytes.
+inline constexpr double kMaxQuadrotorSimBytes = 2e9;
+/// Bytes per item that QuadrotorSimBytes counts (the stored sample plus its CSV row), measured on
+/// the shipped vehicle: a truth sample, a landmark, a frame (its initial pose) and a pixel measurement.
+inline constexpr double kTruthSampleBytes = 520, kLandmarkBytes = 110, kFrameBytes = 260, kPixelBytes = 130;
+
+/// The memory SimulateQuadrotor would take, bytes: truth samples (duration · truth_rate_hz),
+/// landmarks, and per camera frame (duration · camera.rate_hz) its initial pose and up to
+/// min(max_features_per_frame, landmarks) pixel measurements, each at the sizes above.
+double QuadrotorSimBytes(const estim::Vehicle& vehicle, const QuadrotorSimOptions& options);
+
 /// Simulates a flight: the estimator's input (estim/quadrotor_data.h) with its ground truth at
 /// truth_rate_hz. Throws OptionError for bad options (Validate), InputError for a bad vehicle,
+/// ComputeError when QuadrotorSimBytes exceeds kMaxQuadrotorSimBytes (naming camera.rate_hz),
 /// ComputeError if the vehicle cannot fly the scenario (a command beyond the rotor limit for more
 /// than 1 % of the steps).
 estim::QuadrotorData SimulateQuadrotor(const estim::Vehicle& vehicle, const QuadrotorSimOptions& options);
