@@ -4,6 +4,9 @@
 #include <charconv>
 #include <cmath>
 #include <numeric>
+#include <optional>
+#include <string>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -267,6 +270,25 @@ void CheckPlottedMemory(const ReportInput& reference, const std::vector<ReportIn
                MemoryCost::kData});
 }
 
+// The JSON pointer and value of the first number of `json` that is not finite (nlohmann writes it as
+// null), depth first; nullopt when every number is finite.
+std::optional<std::pair<std::string, double>> FirstNonFinite(const Json& json, const std::string& at = "") {
+  if (json.is_number_float()) {
+    const double value = json.get<double>();
+    return std::isfinite(value) ? std::nullopt : std::optional(std::pair(at.empty() ? "/" : at, value));
+  }
+  if (json.is_object()) {
+    for (const auto& [key, item] : json.items()) {
+      if (auto bad = FirstNonFinite(item, at + "/" + key)) return bad;
+    }
+  } else if (json.is_array()) {
+    for (size_t i = 0; i < json.size(); ++i) {
+      if (auto bad = FirstNonFinite(json[i], at + "/" + std::to_string(i))) return bad;
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>& estimates,
@@ -358,6 +380,13 @@ Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>&
   data["reference_velocity"] = ReferenceVelocity(reference, options, clock, &report.notes, &fit);
   data["fit"] = std::move(fit);
   data["notes"] = report.notes;
+  // The APE and ASE are finite (eval::Evaluate checks them); what is computed for the charts alone
+  // (reference velocities, speeds, the fit's residuals) may still overflow on huge coordinates.
+  if (const auto bad = FirstNonFinite(data)) {
+    throw ComputeError(fmt::format("the report's value {} is {}, not a finite number: the coordinates are too large "
+                                   "to compute with, a value overflowed",
+                                   bad->first, bad->second));
+  }
   report.data_json = data.dump();
   return report;
 }

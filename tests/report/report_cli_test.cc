@@ -314,6 +314,13 @@ TEST_F(ReportCliTest, MaxPointsIsBoundedByWhatItCosts) {
   EXPECT_EQ(run.exit_code, 3) << run.err;
   EXPECT_NE(run.err.find("not a finite number: the coordinates are too large"), std::string::npos) << run.err;
   EXPECT_FALSE(std::filesystem::exists(out));
+  // The APE of a file against itself is 0, but its speed from 1e300 positions overflows: the page
+  // held nulls with exit 0.
+  run = Cheval(fmt::format("report {} {} -o {} --align none", Path("huge.tum"), Path("huge.tum"), out));
+  EXPECT_EQ(run.exit_code, 3) << run.err;
+  EXPECT_NE(run.err.find("cheval: error: the report's value /reference_velocity/"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find(", not a finite number: the coordinates are too large"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 // A build without the chart library: `cheval report` says so (exit 1) before reading anything.
