@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <span>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -37,6 +40,78 @@ std::string AlignmentLine(const AlignmentResult& alignment, Eigen::Index pairs) 
     line += fmt::format(" (aligned poses: {})", alignment.pairs_used);
   }
   return line;
+}
+
+std::string_view MetricLabel(MetricKind metric) {
+  return metric == MetricKind::kApe ? "APE" : metric == MetricKind::kRpe ? "RPE" : "ASE";
+}
+
+// Why a result is not finite: the inputs are (the readers accept only finite numbers), so an
+// intermediate value overflowed; or the caller's arrays held a non-finite value.
+std::string NonFiniteReason(const traj::TrajectoryView& ref, const traj::TrajectoryView& est) {
+  double largest = 0.0;
+  for (const traj::TrajectoryView* side : {&ref, &est}) {
+    if (side->empty()) continue;
+    const bool velocity = side->has_velocity();
+    if (!side->positions().allFinite() || (velocity && !side->velocities().allFinite())) {
+      return "the inputs hold a value that is not a finite number";
+    }
+    largest = std::max(largest, side->positions().cwiseAbs().maxCoeff());
+    if (velocity) largest = std::max(largest, side->velocities().cwiseAbs().maxCoeff());
+  }
+  return fmt::format("the coordinates are too large to compute with, a value overflowed (largest magnitude {:.3g})",
+                     largest);
+}
+
+// The first non-finite entry of `values` (nullopt when all are finite).
+std::optional<size_t> FirstNonFinite(std::span<const double> values) {
+  const auto bad = std::find_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); });
+  return bad == values.end() ? std::nullopt : std::optional<size_t>(static_cast<size_t>(bad - values.begin()));
+}
+
+// Throws ComputeError when anything Evaluate computed is not a finite number (never a NaN or an
+// infinity in a result, a statistic, the JSON or the CSV): the alignment, each error and ASE part
+// (naming the pair, 1-based, and its estimate stamp), the statistics, the KITTI drift.
+void RequireFinite(const EvaluationResult& r, const traj::TrajectoryView& ref, const traj::TrajectoryView& est) {
+  const std::string_view metric = MetricLabel(r.metric);
+  auto fail = [&](const std::string& what, std::string_view value) {
+    throw ComputeError(fmt::format("{} is {}, not a finite number: {}", what, value, NonFiniteReason(ref, est)));
+  };
+  auto fail_value = [&](const std::string& what, double value) { fail(what, fmt::format("{}", value)); };
+  const Similarity& s = r.alignment.transform;
+  if (!s.rotation.allFinite() || !s.translation.allFinite() || !std::isfinite(s.scale)) {
+    fail(fmt::format("the {} alignment", ToString(r.alignment.method)), "partly undefined");
+  }
+  auto check_pairs = [&](std::span<const double> values, std::string_view part) {
+    if (const std::optional<size_t> k = FirstNonFinite(values)) {
+      std::string stamp;
+      if (*k < r.stamps_ns.size() && est.has_stamps()) stamp = fmt::format(" (estimate stamp {} s)", traj::FormatSeconds(r.stamps_ns[*k]));
+      fail_value(fmt::format("the {}{} of pair {} of {}{}", metric, part, *k + 1, values.size(), stamp), values[*k]);
+    }
+  };
+  check_pairs(r.errors, "");
+  if (r.ase) {
+    check_pairs(r.ase->rotation, " rotation part");
+    check_pairs(r.ase->position, " position part");
+    check_pairs(r.ase->velocity, " velocity part");
+  }
+  const std::pair<const ErrorStatistics*, std::string_view> stats[] = {
+      {&r.stats, ""}, {&r.rotation_stats, " rotation"}, {&r.position_stats, " position"}, {&r.velocity_stats, " velocity"}};
+  for (const auto& [st, part] : stats) {
+    const std::pair<std::string_view, double> values[] = {{"rmse", st->rmse}, {"mean", st->mean}, {"median", st->median},
+                                                          {"std", st->std},   {"min", st->min},   {"max", st->max},
+                                                          {"sse", st->sse}};
+    for (const auto& [name, value] : values) {
+      if (!std::isfinite(value)) fail_value(fmt::format("the {}{} {}", metric, part, name), value);
+    }
+  }
+  if (r.drift) {
+    bool finite = std::isfinite(r.drift->translation_percent) && std::isfinite(r.drift->rotation_deg_per_m);
+    for (const DriftResult::Length& l : r.drift->lengths) {
+      finite = finite && std::isfinite(l.translation_percent) && std::isfinite(l.rotation_deg_per_m);
+    }
+    if (!finite) fail("the KITTI drift", "partly undefined");
+  }
 }
 
 std::string UnitText(std::string_view unit) { return unit.empty() ? "unit-less" : std::string(unit); }
@@ -240,6 +315,7 @@ EvaluationResult Evaluate(const traj::TrajectoryView& ref, const traj::Trajector
   }
   result.title += "\n" + alignment_line;
   result.stats = ComputeStatistics(result.errors);
+  RequireFinite(result, reference, est);
   return result;
 }
 
@@ -247,13 +323,21 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
+// A text field of a CSV row as RFC 4180 has it: in double quotes, inner quotes doubled, when it holds a
+// comma, a quote, a CR or a LF (a file name may); as it is otherwise.
+std::string CsvField(std::string_view text) {
+  if (text.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(text);
+  std::string quoted = "\"";
+  for (const char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c;
+  }
+  return quoted + '"';
+}
+
 Json StatisticsJson(const ErrorStatistics& s) {
   return Json{{"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median}, {"std", s.std},
               {"min", s.min},   {"max", s.max},   {"sse", s.sse},       {"n", s.n}};
-}
-
-std::string_view MetricLabel(MetricKind metric) {
-  return metric == MetricKind::kApe ? "APE" : metric == MetricKind::kRpe ? "RPE" : "ASE";
 }
 
 Json ReportJson(const EvaluationReport& report) {
@@ -330,8 +414,9 @@ std::string EvaluationErrorsCsv(std::span<const EvaluationReport> reports) {
   fmt::format_to(it, "{}\n", header);
   for (const EvaluationReport& report : reports) {
     const EvaluationResult& r = report.result;
+    const std::string estimate = CsvField(report.estimate_path);
     for (size_t k = 0; k < r.errors.size(); ++k) {
-      if (several) fmt::format_to(it, "{},", report.estimate_path);
+      if (several) fmt::format_to(it, "{},", estimate);
       fmt::format_to(it, "{}", traj::FormatSeconds(r.stamps_ns[k]));
       if (rpe) fmt::format_to(it, ",{}", traj::FormatSeconds(r.stamps_end_ns[k]));
       fmt::format_to(it, ",{}", r.errors[k]);

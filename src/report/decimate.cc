@@ -47,8 +47,14 @@ std::vector<Eigen::Index> StrideDecimation(Eigen::Index n, std::size_t max_point
   if (max_points < 2) throw std::invalid_argument("StrideDecimation: max_points must be at least 2");
   std::vector<Eigen::Index> kept;
   if (n <= 0) return kept;
-  const auto limit = static_cast<Eigen::Index>(max_points);
-  const Eigen::Index stride = n <= limit ? 1 : (n - 1 + limit - 2) / (limit - 1);
+  // Compared as sizes: a max_points beyond Eigen::Index (a wrapped -1) must not turn negative.
+  if (static_cast<std::size_t>(n) <= max_points) {
+    kept.resize(static_cast<std::size_t>(n));
+    std::iota(kept.begin(), kept.end(), Eigen::Index{0});
+    return kept;
+  }
+  const auto limit = static_cast<Eigen::Index>(max_points);  // < n here
+  const Eigen::Index stride = (n - 1 + limit - 2) / (limit - 1);
   for (Eigen::Index i = 0; i < n; i += stride) kept.push_back(i);
   if (kept.back() != n - 1) kept.push_back(n - 1);
   return kept;

@@ -4,11 +4,15 @@
 #include <charconv>
 #include <cmath>
 #include <numeric>
+#include <optional>
+#include <string>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "cheval/common/error.h"
+#include "cheval/common/memory.h"
 #include "cheval/common/option_names.h"
 #include "cheval/common/options.h"
 #include "cheval/eval/pairs.h"
@@ -241,9 +245,56 @@ void ReportOptions::Validate() const {
   check(max_fit_windows >= 1, "max_fit_windows", "must be at least 1, got {}", max_fit_windows);
 }
 
+namespace {
+
+// The memory the plotted series take, before anything is computed: every plotted number is a JSON
+// value, its text in the data and its copy in the page (measured: 36 bytes a value on 200,000-pose
+// files with max_points above that). A series has at most min(its samples, max_points) points; the
+// reference has its path (3 columns) and up to three velocities (t, vx, vy, vz, speed), each estimate
+// its APE series (t, error) and path, and with velocity its ASE series and velocity (5 columns each).
+void CheckPlottedMemory(const ReportInput& reference, const std::vector<ReportInput>& estimates,
+                        const ReportOptions& options) {
+  constexpr double kBytesPerValue = 64;
+  auto points = [&](Eigen::Index samples) {
+    return static_cast<double>(std::min(static_cast<std::size_t>(std::max<Eigen::Index>(samples, 0)), options.max_points));
+  };
+  const traj::TrajectoryView& ref = reference.trajectory;
+  double values = points(ref.size()) * (3 + 5 * (ref.has_velocity() ? 3 : 2));
+  for (const ReportInput& estimate : estimates) {
+    const traj::TrajectoryView& est = estimate.trajectory;
+    values += points(est.size()) * (2 + 3 + (est.has_velocity() ? 10 : 0));
+  }
+  CheckMemory({"ReportOptions", "max_points", values * kBytesPerValue,
+               fmt::format("{:.4g} plotted values for {} poses of the reference and {} estimate(s)", values, ref.size(),
+                           estimates.size()),
+               MemoryCost::kData});
+}
+
+// The JSON pointer and value of the first number of `json` that is not finite (nlohmann writes it as
+// null), depth first; nullopt when every number is finite.
+std::optional<std::pair<std::string, double>> FirstNonFinite(const Json& json, const std::string& at = "") {
+  if (json.is_number_float()) {
+    const double value = json.get<double>();
+    return std::isfinite(value) ? std::nullopt : std::optional(std::pair(at.empty() ? "/" : at, value));
+  }
+  if (json.is_object()) {
+    for (const auto& [key, item] : json.items()) {
+      if (auto bad = FirstNonFinite(item, at + "/" + key)) return bad;
+    }
+  } else if (json.is_array()) {
+    for (size_t i = 0; i < json.size(); ++i) {
+      if (auto bad = FirstNonFinite(json[i], at + "/" + std::to_string(i))) return bad;
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>& estimates,
                    const ReportOptions& options) {
   options.Validate();
+  CheckPlottedMemory(reference, estimates, options);
   const traj::TrajectoryView& ref = reference.trajectory;
   Clock clock;
   clock.stamps = ref.has_stamps() && !ref.empty();
@@ -329,6 +380,13 @@ Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>&
   data["reference_velocity"] = ReferenceVelocity(reference, options, clock, &report.notes, &fit);
   data["fit"] = std::move(fit);
   data["notes"] = report.notes;
+  // The APE and ASE are finite (eval::Evaluate checks them); what is computed for the charts alone
+  // (reference velocities, speeds, the fit's residuals) may still overflow on huge coordinates.
+  if (const auto bad = FirstNonFinite(data)) {
+    throw ComputeError(fmt::format("the report's value {} is {}, not a finite number: the coordinates are too large "
+                                   "to compute with, a value overflowed",
+                                   bad->first, bad->second));
+  }
   report.data_json = data.dump();
   return report;
 }

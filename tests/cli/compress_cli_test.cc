@@ -179,11 +179,18 @@ TEST_F(CompressCliTest, BadInputHasItsExitCodeAndLeavesNoFile) {
   const RunResult same = Cheval("compress " + Path("same.txt") + " -o " + Path("out.json"));
   EXPECT_EQ(same.exit_code, 3);
   EXPECT_EQ(same.err, "cheval: error: all 3 stamps are equal: there is no time to fit over\n");
-  for (const char* bad : {"nan", "0", "-1", "inf"}) {
+  for (const char* bad : {"0", "-1"}) {
     const RunResult run = Cheval("compress " + Path("same.txt") + " -o " + Path("out.json") + " --tolerance " + bad);
     EXPECT_EQ(run.exit_code, 1) << bad;
     EXPECT_EQ(run.err,
               std::string("cheval: error: --tolerance must be a positive number of metres, got ") + bad + "\n");
+  }
+  // Not a finite number: refused as the flag's text, before the library sees it (docs/cli.md, "Option values").
+  for (const char* bad : {"nan", "inf"}) {
+    const RunResult run = Cheval("compress " + Path("same.txt") + " -o " + Path("out.json") + " --tolerance " + bad);
+    EXPECT_EQ(run.exit_code, 1) << bad;
+    EXPECT_EQ(run.err, std::string("cheval: error: --tolerance: must be a finite number, got ") + bad +
+                           "\nRun 'cheval --help' for usage.\n");
   }
   EXPECT_EQ(Cheval("compress " + Path("same.txt") + " -o " + Path("out.json") + " --tolerance abc").exit_code, 1);
   EXPECT_EQ(Cheval("compress " + Path("same.txt")).exit_code, 1);  // -o is required
@@ -194,12 +201,15 @@ TEST_F(CompressCliTest, BadInputHasItsExitCodeAndLeavesNoFile) {
 
   // sample: options, then malformed and missing models.
   std::ofstream(Path("model.json")) << "{\"format\": \"cheval-trajectory-model\", \"version\": 7}\n";
-  for (const char* bad : {"nan", "0", "-2"}) {
+  for (const char* bad : {"0", "-2"}) {
     const RunResult run =
         Cheval("sample " + Path("model.json") + " --rate " + std::string(bad) + " -o " + Path("s.txt"));
     EXPECT_EQ(run.exit_code, 1) << bad;
     EXPECT_EQ(run.err, std::string("cheval: error: --rate must be a positive number of Hz, got ") + bad + "\n");
   }
+  const RunResult nan_rate = Cheval("sample " + Path("model.json") + " --rate nan -o " + Path("s.txt"));
+  EXPECT_EQ(nan_rate.exit_code, 1);
+  EXPECT_EQ(nan_rate.err, "cheval: error: --rate: must be a finite number, got nan\nRun 'cheval --help' for usage.\n");
   const RunResult neither = Cheval("sample " + Path("model.json") + " -o " + Path("s.txt"));
   EXPECT_EQ(neither.exit_code, 1);
   EXPECT_EQ(neither.err, "cheval: error: sample needs --rate HZ or --at FILE\n");

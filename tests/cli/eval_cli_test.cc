@@ -246,7 +246,8 @@ TEST_F(EvalCliTest, OptionErrorsNameTheFlag) {
       {"ase {} {} --association continuous --gt-velocity given",
        "--association continuous takes the reference velocity from its Chebyshev curve: use --gt-velocity auto or "
        "chebyshev"},
-      {"ape {} {}.missing --n-align -2 --align se3", "--n-align must be positive, got -2"},
+      {"ape {} {}.missing --n-align -2 --align se3",
+       "--n-align must be at least 1 (leave it out to align on all pairs), got -2"},
   };
   for (const auto& [args, message] : cases) {
     const Output run = Run(fmt::format(fmt::runtime(args), ref, est) + json);

@@ -199,6 +199,71 @@ TEST(EvaluateTest, JsonAndErrorsCsvRepeatTheResult) {
   EXPECT_EQ(both.substr(both.find('\n') + 1, 8), "est.txt,");
 }
 
+// Issue 13: a file name with a comma or a quote broke the CSV's columns. RFC 4180: such a field is
+// quoted, inner quotes doubled; a plain name stays as it is.
+TEST(EvaluateTest, ErrorsCsvQuotesEstimateNamesAsRfc4180) {
+  const traj::Trajectory ref = MakeTrajectory(Helix(5));
+  const traj::Trajectory est = MakeTrajectory(Moved(Helix(5), Eigen::Quaterniond::Identity(), {0, 0, 0.25}));
+  EvaluationReport report;
+  report.options.association = AssociationOptions::FromSeconds(0.02, 0.0);
+  report.result = Evaluate(ref.View(), est.View(), report.options);
+  std::vector<EvaluationReport> reports = {report, report, report};
+  reports[0].estimate_path = "run 1,2.txt";
+  reports[1].estimate_path = "say \"hi\".txt";
+  reports[2].estimate_path = "plain.txt";
+  const std::string csv = EvaluationErrorsCsv(reports);
+  std::vector<std::string> lines;
+  for (size_t begin = 0, end; (end = csv.find('\n', begin)) != std::string::npos; begin = end + 1) {
+    lines.push_back(csv.substr(begin, end - begin));
+  }
+  ASSERT_EQ(lines.size(), 16u);
+  EXPECT_EQ(lines[1], "\"run 1,2.txt\",1.000000000,0.25");
+  EXPECT_EQ(lines[6], "\"say \"\"hi\"\".txt\",1.000000000,0.25");
+  EXPECT_EQ(lines[11], "plain.txt,1.000000000,0.25");
+}
+
+// Issue 13: coordinates of 1e300 gave inf errors, "std -nan", JSON nulls and exit 0. Every non-finite
+// result is a ComputeError saying what and why.
+TEST(EvaluateTest, ANonFiniteResultIsAComputeErrorNamingThePairAndTheReason) {
+  auto scaled = [](double factor) {
+    std::vector<PoseSpec> poses = Helix(50);
+    for (PoseSpec& s : poses) s.p *= factor;
+    return MakeTrajectory(poses, true);
+  };
+  const traj::Trajectory est = MakeTrajectory(Helix(50), true);
+  auto message = [&](const traj::Trajectory& ref, MetricKind metric, AlignmentMethod align) -> std::string {
+    EvaluationOptions options;
+    options.metric = metric;
+    options.alignment.method = align;
+    options.association = AssociationOptions::FromSeconds(0.02, 0.0);
+    try {
+      const EvaluationResult r = Evaluate(ref.View(), est.View(), options);
+      return "no error, rmse " + std::to_string(r.stats.rmse) + " std " + std::to_string(r.stats.std);
+    } catch (const ComputeError& e) {
+      return e.what();
+    }
+  };
+  // An error overflows (|p| ~ 1e300 squared).
+  const traj::Trajectory huge = scaled(1e300);
+  for (const MetricKind metric : {MetricKind::kApe, MetricKind::kRpe, MetricKind::kAse}) {
+    const std::string m = message(huge, metric, AlignmentMethod::kNone);
+    SCOPED_TRACE(m);
+    const std::string label = metric == MetricKind::kApe ? "APE" : metric == MetricKind::kRpe ? "RPE" : "ASE";
+    EXPECT_EQ(m.rfind("the " + label + " of pair ", 0), 0u);
+    EXPECT_NE(m.find("(estimate stamp 1.0"), std::string::npos);
+    EXPECT_NE(m.find("not a finite number: the coordinates are too large"), std::string::npos);
+  }
+  // Each error is finite (~3e153) but their sum of squares is not.
+  const std::string sse = message(scaled(3e153), MetricKind::kApe, AlignmentMethod::kNone);
+  EXPECT_EQ(sse.rfind("the APE rmse is inf, not a finite number", 0), 0u) << sse;
+  // An alignment solved on such coordinates.
+  const std::string aligned = message(huge, MetricKind::kApe, AlignmentMethod::kSim3);
+  EXPECT_TRUE(aligned.rfind("the sim3 alignment is ", 0) == 0 || aligned.rfind("the APE of pair", 0) == 0) << aligned;
+  EXPECT_NE(aligned.find("not a finite number"), std::string::npos) << aligned;
+  // Large but computable coordinates still evaluate.
+  EXPECT_EQ(message(scaled(1e100), MetricKind::kApe, AlignmentMethod::kNone).rfind("no error", 0), 0u);
+}
+
 TEST(EvaluateTest, NamesOfTheEnumsRoundTrip) {
   for (ReferenceVelocitySource s : {ReferenceVelocitySource::kAuto, ReferenceVelocitySource::kGiven,
                                     ReferenceVelocitySource::kChebyshev, ReferenceVelocitySource::kCentral}) {

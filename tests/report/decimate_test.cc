@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -81,6 +82,19 @@ TEST(StrideDecimationTest, EvenlySpacedWithBothEnds) {
     }
   }
   EXPECT_THROW(StrideDecimation(10, 1), std::invalid_argument);
+}
+
+// Issue 13: `cheval report --max-points -1` (SIZE_MAX) turned negative as an Eigen::Index, and the
+// stride loop grew without end (16.8 GB, then std::bad_alloc). Any max_points at or above n keeps all.
+TEST(StrideDecimationTest, AMaxPointsBeyondTheIndexRangeKeepsEverySample) {
+  const std::vector<Eigen::Index> all = {0, 1, 2, 3, 4};
+  for (const std::size_t max_points : {std::numeric_limits<std::size_t>::max(), std::size_t{1} << 63,
+                                       (std::size_t{1} << 63) + 5}) {
+    EXPECT_EQ(StrideDecimation(5, max_points), all) << max_points;
+  }
+  const std::vector<double> a = Noisy(5, 0);
+  const std::vector<std::span<const double>> columns = {a};
+  EXPECT_EQ(MinMaxDecimation(columns, std::numeric_limits<std::size_t>::max()), all);
 }
 
 }  // namespace

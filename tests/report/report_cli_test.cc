@@ -277,6 +277,52 @@ TEST_F(ReportCliTest, BadInputGivesTheDocumentedExitCodesAndNoFile) {
   EXPECT_NE(unwritable.err.find("cannot write"), std::string::npos) << unwritable.err;
 }
 
+// Issue 13: `--max-points -1` (wrapped to 2^64 - 1) grew without end (16.8 GB, exit 70). Now any
+// number of points at or above the poses keeps them all; what the plotted series would cost is checked
+// against the memory limit first (exit 3: it depends on the data); --n-align 0 is not ignored; an
+// APE that is not finite is exit 3.
+TEST_F(ReportCliTest, MaxPointsIsBoundedByWhatItCosts) {
+  Simulate(20);
+  const std::string ref = Path("truth.tumv"), est = Path("noisy_v.tumv"), out = Path("r.html");
+  const std::string report = fmt::format("{} report {} {} -o {} --quiet", CHEVAL_EXE, ref, est, out);
+  auto run = Shell(report + " --max-points 18446744073709551615");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const Json data = EmbeddedData(Slurp(out));
+  EXPECT_EQ(data["estimates"][0]["ape_series"]["t"].size(), data["estimates"][0]["ape_series"]["n"].get<size_t>());
+  std::filesystem::remove(out);
+  // 4001 + 1001 poses: every value of every series needs about 5 MB, the default 5000 points the same.
+  run = Shell("CHEVAL_MEMORY_LIMIT=1M " + report + " --max-points 18446744073709551615");
+  EXPECT_EQ(run.exit_code, 3) << run.err;
+  EXPECT_NE(run.err.find("cheval: error: --max-points would need about"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("plotted values for 4001 poses of the reference and 1 estimate(s)); the limit is 1.05 MB"),
+            std::string::npos)
+      << run.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  run = Shell("CHEVAL_MEMORY_LIMIT=1M " + report + " --max-points 100");
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  std::filesystem::remove(out);
+  run = Cheval(fmt::format("report {} {} -o {} --n-align 0", ref, est, out));
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("--n-align must be at least 1"), std::string::npos) << run.err;
+  {
+    std::ofstream huge(Path("huge.tum"));
+    for (int i = 0; i < 20; ++i) huge << 1.0 + 0.1 * i << " " << 1e300 * (1 + i) << " 0 0 0 0 0 1\n";
+    std::ofstream small(Path("small.tum"));
+    for (int i = 0; i < 20; ++i) small << 1.0 + 0.1 * i << " " << i << " 0 0 0 0 0 1\n";
+  }
+  run = Cheval(fmt::format("report {} {} -o {} --align none", Path("huge.tum"), Path("small.tum"), out));
+  EXPECT_EQ(run.exit_code, 3) << run.err;
+  EXPECT_NE(run.err.find("not a finite number: the coordinates are too large"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  // The APE of a file against itself is 0, but its speed from 1e300 positions overflows: the page
+  // held nulls with exit 0.
+  run = Cheval(fmt::format("report {} {} -o {} --align none", Path("huge.tum"), Path("huge.tum"), out));
+  EXPECT_EQ(run.exit_code, 3) << run.err;
+  EXPECT_NE(run.err.find("cheval: error: the report's value /reference_velocity/"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find(", not a finite number: the coordinates are too large"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 // A build without the chart library: `cheval report` says so (exit 1) before reading anything.
 TEST(ReportUnavailableTest, SaysHowToGetTheReport) {
   if (CHEVAL_REPORT_AVAILABLE) GTEST_SKIP() << "built with the report (CHEVAL_BUILD_REPORT=ON)";

@@ -37,6 +37,17 @@ std::vector<int64_t> ReadQueryStamps(const std::string& path);
 /// flag). Empty paths are options not given and are skipped.
 void RefuseSharedPaths(const std::vector<std::string>& inputs, const std::vector<OutputPath>& outputs);
 
+/// Gives every numeric option of `app` and its subcommands (recursively) a check of its text before
+/// CLI11 converts it (CLI11 2.1 would accept "-1" for an unsigned option and wrap it, saturate
+/// "99999999999999999999", read "010" as octal, and take "nan", "inf" and "1e400" for a double):
+/// - integer options (CLI11 type INT / UINT): decimal digits with an optional sign ('-' only for INT),
+///   within the range of a 64-bit integer (narrower types are range-checked by CLI11);
+/// - floating-point options (FLOAT): a decimal number whose value is finite (no nan, no inf, no
+///   overflow).
+/// Anything else is a parse error naming the flag (exit 1): "--max-points: must be a whole number >= 0,
+/// got -1". Called once by main after every subcommand is registered.
+void CheckNumericOptions(CLI::App* app);
+
 /// The action a subcommand registers; main runs it after parsing, inside its error mapping.
 using Action = std::function<void()>;
 

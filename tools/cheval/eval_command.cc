@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cheval/common/error.h"
+#include "cheval/common/options.h"
 #include "progress.h"
 #include "cheval/traj/stamp.h"
 
@@ -34,6 +35,13 @@ traj::ReadOptions SideOptions(CLI::App* command, const EvalFlags& flags, const s
 eval::EvaluationOptions ToEvaluationOptions(eval::MetricKind metric, const EvalFlags& flags) {
   eval::EvaluationOptions options = flags.options;
   options.metric = metric;
+  if (flags.n_align) {
+    // The library reads 0 as "all pairs"; a given --n-align 0 would be ignored silently.
+    const OptionCheck check("AlignmentOptions");
+    check(*flags.n_align >= 1, "n_align", "must be at least 1 (leave it out to align on all pairs), got {}",
+          *flags.n_align);
+    options.alignment.n_align = *flags.n_align;
+  }
   options.association = eval::AssociationOptions::FromSeconds(flags.t_max_diff, flags.t_offset);
   options.continuous_reference = flags.association == "continuous";
   options.alignment.method = *eval::AlignmentMethodFromString(flags.align);
@@ -175,7 +183,7 @@ void AddEvalInputFlags(CLI::App* command, EvalFlags* flags) {
   command->add_option(Flag("AlignmentOptions::method"), flags->align, "Alignment of each estimate onto the reference")
       ->check(CLI::IsMember({"none", "origin", "se3", "sim3", "scale", "posyaw", "full"}))
       ->capture_default_str();
-  command->add_option(Flag("AlignmentOptions::n_align"), flags->options.alignment.n_align, "Solve the alignment from the first N pairs only (default: all)");
+  command->add_option(Flag("AlignmentOptions::n_align"), flags->n_align, "Solve the alignment from the first N pairs only (default: all)");
   command->add_option(Flag("AssociationOptions::max_diff_ns"), flags->t_max_diff, "Largest stamp difference of an associated pair, seconds")
       ->capture_default_str();
   command->add_option(Flag("AssociationOptions::offset_ns"), flags->t_offset, "Added to the estimate stamps: est + offset = ref, seconds")

@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,7 @@ struct EvalFlags {
   InputFlags both, ref, est;
   eval::EvaluationOptions options;
   std::string align{eval::ToString(options.alignment.method)};
+  std::optional<Eigen::Index> n_align;  // --n-align: unset means all pairs (the library's 0)
   double t_max_diff = options.association.max_diff_s();
   double t_offset = options.association.offset_s();
   std::string association = options.continuous_reference ? "continuous" : "nearest";

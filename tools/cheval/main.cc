@@ -1,9 +1,13 @@
 // cheval: one executable, one subcommand per file. main() parses, runs the chosen action and maps
 // the library's typed errors to the documented exit codes (docs/cli.md), each message with the
 // library's option fields spelled as flags (option_names.h).
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <exception>
+#include <new>
 #include <string>
+#include <system_error>
 
 #include <fmt/format.h>
 
@@ -36,10 +40,16 @@ int main(int argc, char** argv) {
   cheval::cli::RegisterSimQuadrotor(app, &action);
   cheval::cli::RegisterEstimate(app, &action);
   cheval::cli::RegisterEstimateThrust(app, &action);
+  cheval::cli::CheckNumericOptions(&app);
 
   auto fail = [](ExitCode code, const std::string& message) {
     std::fprintf(stderr, "%s\n", cheval::cli::Spell(message).c_str());
     return static_cast<int>(code);
+  };
+  // What a command prints on standard output is part of its result: a write that failed (a full disk,
+  // a closed pipe when SIGPIPE is ignored) is exit 4, not a success with the result lost.
+  auto stdout_failed = [&fail](const std::string& reason) {
+    return fail(ExitCode::kOutput, fmt::format("<stdout>: error: cannot write: {}", reason));
   };
   try {
     app.parse(argc, argv);
@@ -55,6 +65,10 @@ int main(int argc, char** argv) {
   cheval::cli::SetQuiet(quiet);
   try {
     if (action) action();
+    errno = 0;
+    if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+      return stdout_failed(errno != 0 ? std::strerror(errno) : "write error");
+    }
     return static_cast<int>(ExitCode::kOk);
   } catch (const cheval::InputError& e) {
     return fail(ExitCode::kInput, e.what());
@@ -64,6 +78,15 @@ int main(int argc, char** argv) {
     return fail(ExitCode::kCompute, fmt::format("cheval: error: {}", e.what()));
   } catch (const cheval::OutputError& e) {
     return fail(ExitCode::kOutput, e.what());
+  } catch (const std::bad_alloc&) {
+    // The limits of docs/cli.md refuse what options and inputs would need beyond the memory limit
+    // before allocating; what still does not fit is a computation that cannot be done here.
+    return fail(ExitCode::kCompute, "cheval: error: out of memory (the machine or the process's limits do not "
+                                    "have the memory this run needs)");
+  } catch (const std::system_error& e) {
+    // fmt::print throws when a write to standard output fails.
+    if (std::ferror(stdout)) return stdout_failed(e.code().message());
+    return fail(ExitCode::kInternal, fmt::format("cheval: internal error (please report): {}", e.what()));
   } catch (const std::exception& e) {
     return fail(ExitCode::kInternal, fmt::format("cheval: internal error (please report): {}", e.what()));
   }

@@ -37,6 +37,8 @@ constexpr std::array kFlags = std::to_array<OptionName>({
     {"CurveOptions::window_s", "--window"},
     // cheb::CompressOptions
     {"CompressOptions::tolerance", "--tolerance"},
+    // cheb::ModelGridStamps (`cheval sample --rate`)
+    {"ModelGridStamps::rate_hz", "--rate"},
     // report::ReportOptions
     {"ReportOptions::max_points", "--max-points"},
     // sim::MotionOptions, MeasurementOptions, EstimatorSimOptions

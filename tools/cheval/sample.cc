@@ -7,6 +7,7 @@
 
 #include "cheval/cheb/model.h"
 #include "cheval/common/error.h"
+#include "cheval/common/memory.h"
 #include "common.h"
 
 namespace cheval::cli {
@@ -51,6 +52,16 @@ void RegisterSample(CLI::App& app, Action* action) {
       }
       std::vector<int64_t> stamps;
       if (flags->rate_hz) {
+        if (!model.segments.empty()) {
+          // Each stamp costs its stamp, its position, a TUM pose and its line of text (measured: 177
+          // bytes a stamp); checked before ModelGridStamps allocates the grid.
+          constexpr double kBytesPerStamp = 200;
+          const double span_s =
+              (static_cast<double>(model.segments.back().last_ns) - static_cast<double>(model.origin_ns)) * 1e-9;
+          const double count = std::floor(span_s * *flags->rate_hz) + 1.0;
+          CheckMemory({"ModelGridStamps", "rate_hz", count * kBytesPerStamp,
+                       fmt::format("{:.4g} stamps over the model's {:.3f} s", count, span_s), MemoryCost::kOption});
+        }
         stamps = cheb::ModelGridStamps(model, *flags->rate_hz);
       } else {
         stamps = ReadQueryStamps(flags->at_path);

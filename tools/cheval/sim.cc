@@ -2,11 +2,13 @@
 // (noise, jittered stamps, dropouts, gaps). See docs/sim.md.
 #include <fmt/format.h>
 
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "cheval/common/error.h"
+#include "cheval/common/memory.h"
 #include "cheval/sim/motion.h"
 #include "common.h"
 #include "progress.h"
@@ -89,6 +91,23 @@ void RegisterSim(CLI::App& app, Action* action) {
       if (duration_given) options.duration_s = flags->duration_s;
       if (rate_given) options.rate_hz = flags->rate_hz;
       const sim::MotionModel model(options);
+      // The samples and their text, checked before they are generated (measured: about 330 bytes a
+      // measured sample with the truth it is drawn from, 270 more when the truth is written, 300 a
+      // sample of each estimate).
+      const sim::MotionOptions& resolved = model.options();
+      const double samples = std::floor(*resolved.duration_s * *resolved.rate_hz) + 1.0;
+      const double estimate_samples = std::floor(*resolved.duration_s * flags->estimator.rate_hz) + 1.0;
+      const double measured_bytes = samples * (flags->truth_output.empty() ? 350.0 : 650.0);
+      const double estimate_bytes = static_cast<double>(flags->estimate_outputs.size()) * estimate_samples * 320.0;
+      const bool estimates_dominate = estimate_bytes > measured_bytes;  // the flag to name
+      CheckMemory({estimates_dominate ? "EstimatorSimOptions" : "MotionOptions", "rate_hz",
+                   measured_bytes + estimate_bytes,
+                   fmt::format("{:.4g} samples over {} s{}", samples, *resolved.duration_s,
+                               flags->estimate_outputs.empty()
+                                   ? ""
+                                   : fmt::format(" and {} estimate(s) of {:.4g} samples", flags->estimate_outputs.size(),
+                                                 estimate_samples)),
+                   MemoryCost::kOption});
       const traj::Trajectory measured = sim::Measure(model, flags->measurement);
       const traj::Trajectory truth = sim::GenerateMotion(model);
       // Everything is formatted before anything is written.

@@ -22,7 +22,7 @@ struct VelocityFlags {
   eval::VelocityOptions options;  // angular bound; the rest from the texts below
   std::string method{eval::ToString(options.method)};
   std::string degree = eval::DegreeName(options.curve);
-  double window_s = 0.0;  // 0: not given
+  std::optional<double> window_s;  // unset: not given (a given 0 is refused by the library)
   std::string at_path;
   std::string json_path;
   InputFlags format;
@@ -33,7 +33,7 @@ struct VelocityFlags {
 eval::VelocityOptions ToOptions(const VelocityFlags& flags) {
   eval::VelocityOptions options = flags.options;
   options.method = *eval::VelocityMethodFromString(flags.method);
-  const std::optional<double> window = flags.window_s != 0.0 ? std::optional(flags.window_s) : std::nullopt;
+  const std::optional<double> window = flags.window_s;
   const bool savgol = options.method == eval::VelocityMethod::kSavitzkyGolay;
   options.curve = eval::CurveOptionsFromNames(flags.degree, savgol ? std::nullopt : window);
   if (savgol) options.savgol_window_s = window;
