@@ -15,6 +15,7 @@
 
 #include <fmt/format.h>
 
+#include "cheval/bag/bag.h"
 #include "cheval/common/error.h"
 #include "cheval/traj/io.h"
 #include "cheval/traj/stamp.h"
@@ -661,6 +662,10 @@ Trajectory ParseTrajectory(std::string_view content, const std::string& path, co
 }
 
 Trajectory ReadTrajectory(const std::string& path, const ReadOptions& options, Format* format_read) {
+  if (std::optional<Trajectory> recorded = bag::ReadIfRecording(path, options.topic, options.record_time)) {
+    if (format_read != nullptr) *format_read = Format::kAuto;
+    return std::move(*recorded);
+  }
   return ParseTrajectory(ReadWholeFile(path), path, options, format_read);
 }
 
