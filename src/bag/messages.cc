@@ -15,7 +15,6 @@ namespace cheval::bag {
 namespace {
 
 constexpr std::string_view kMcapMagic("\x89MCAP0\r\n", 8);
-constexpr std::string_view kRos1Magic = "#ROSBAG V2.0\n";
 
 }  // namespace
 
@@ -41,7 +40,7 @@ Container DetectContainer(const std::string& path) {
   const size_t n = std::fread(head, 1, sizeof(head), file);
   std::fclose(file);
   const std::string_view bytes(head, n);
-  if (bytes.substr(0, kRos1Magic.size()) == kRos1Magic) return Container::kRos1;
+  if (bytes.substr(0, 9) == "#ROSBAG V") return Container::kRos1;  // other versions: the reader names them
   if (bytes.substr(0, kMcapMagic.size()) == kMcapMagic) return Container::kMcap;
   return Container::kNone;
 }

@@ -3,6 +3,7 @@
 // index_pos) the connection records and chunk info records. Inside a chunk: connection and message
 // data records. Chunks are read in file order; the index data records after each chunk are checked
 // against the messages the chunk held.
+#include <algorithm>
 #include <map>
 #include <set>
 #include <unordered_map>
@@ -129,6 +130,12 @@ class Ros1Reader {
   Ros1Reader(const std::string& path, const Visitor& visitor) : path_(path), visitor_(visitor) {}
 
   void Read(std::string_view bytes) {
+    if (bytes.substr(0, 9) == "#ROSBAG V" && bytes.substr(0, kMagic.size()) != kMagic) {
+      const std::string_view version = bytes.substr(9, std::min<size_t>(bytes.find('\n'), 16) - 9);
+      throw InputError(path_, 0, 0, fmt::format("ROS 1 bag version {} is not read; expected version 2.0 (rosbag "
+                                                "reindex/fix converts older bags)",
+                                                version));
+    }
     if (bytes.substr(0, kMagic.size()) != kMagic) {
       throw InputError(path_, 0, 0, "not a ROS 1 bag: expected the magic '#ROSBAG V2.0' at byte 0");
     }

@@ -167,7 +167,7 @@ traj::Trajectory ReadTfTrajectory(const std::string& path, const TfChain& chain,
   const auto common = std::find_first_of(from_child.begin(), from_child.end(), from_parent.begin(), from_parent.end());
   const std::string name = fmt::format("{}:{}.{}", chain.topic, chain.parent, chain.child);
   if (common == from_child.end()) {
-    throw ComputeError(fmt::format("{}: error: tf chain {} is broken: '{}' leads up to '{}', '{}' up to '{}'{}", path,
+    throw ComputeError(fmt::format("{}: tf chain {} is broken: '{}' leads up to '{}', '{}' up to '{}'{}", path,
                                    name, chain.child, from_child.back(), chain.parent, from_parent.back(),
                                    edges.count(chain.child) == 0 && edges.count(chain.parent) == 0
                                        ? " (neither frame is in the transforms)"
@@ -216,7 +216,7 @@ traj::Trajectory ReadTfTrajectory(const std::string& path, const TfChain& chain,
     trajectory.Append(t, position, orientation);
   }
   if (trajectory.empty()) {
-    throw ComputeError(fmt::format("{}: error: tf chain {}: no stamp of '{}' lies inside every edge's recorded span",
+    throw ComputeError(fmt::format("{}: tf chain {}: no stamp of '{}' lies inside every edge's recorded span",
                                    path, name, chain.child));
   }
   return trajectory;
