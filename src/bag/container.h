@@ -6,9 +6,11 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <fmt/format.h>
 
+#include "cheval/bag/bag.h"
 #include "cheval/common/error.h"
 
 namespace cheval::bag {
@@ -28,6 +30,9 @@ struct Visitor {
   std::function<void(uint64_t id, int64_t log_time_ns, std::string_view data)> on_message;
 };
 
+// Walks one recording with a visitor (a reader bound to its source).
+using Walker = std::function<void(const Visitor&)>;
+
 void ReadRos1(const std::string& path, const Visitor& visitor);
 void ReadMcap(const std::string& path, const Visitor& visitor);
 void ReadRos2(const std::string& path, const Visitor& visitor);
@@ -36,6 +41,11 @@ void ReadRos2(const std::string& path, const Visitor& visitor);
 // use these.
 void ReadRos1Bytes(std::string_view bytes, const std::string& path, const Visitor& visitor);
 void ReadMcapBytes(std::string_view bytes, const std::string& path, const Visitor& visitor);
+
+// ListTopics and ReadBagTrajectory on any source (`path` names it in messages); the fuzzers use them
+// on bytes in memory.
+std::vector<TopicInfo> ListTopicsWith(const Walker& walk);
+traj::Trajectory ReadTrajectoryWith(const std::string& path, const Walker& walk, const BagReadOptions& options);
 
 // The whole file; InputError when it cannot be read.
 std::string ReadFileBytes(const std::string& path);

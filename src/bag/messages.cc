@@ -162,6 +162,10 @@ std::string TypeList() {
 
 std::vector<TopicInfo> ListTopics(const std::string& path) {
   const Container container = RequireContainer(path);
+  return ListTopicsWith([&](const Visitor& visitor) { Walk(path, container, visitor); });
+}
+
+std::vector<TopicInfo> ListTopicsWith(const Walker& walk) {
   std::map<uint64_t, size_t> index;  // connection -> topic slot
   std::vector<TopicInfo> topics;
   Visitor visitor;
@@ -175,7 +179,7 @@ std::vector<TopicInfo> ListTopics(const std::string& path) {
     return true;
   };
   visitor.on_message = [&](uint64_t id, int64_t, std::string_view) { ++topics[index[id]].count; };
-  Walk(path, container, visitor);
+  walk(visitor);
   std::sort(topics.begin(), topics.end(), [](const TopicInfo& a, const TopicInfo& b) {
     return a.name != b.name ? a.name < b.name : a.type < b.type;
   });
@@ -188,9 +192,13 @@ void BagReadOptions::Validate() const {
 
 traj::Trajectory ReadBagTrajectory(const std::string& path, const BagReadOptions& options) {
   const Container container = RequireContainer(path);
+  return ReadTrajectoryWith(path, [&](const Visitor& visitor) { Walk(path, container, visitor); }, options);
+}
+
+traj::Trajectory ReadTrajectoryWith(const std::string& path, const Walker& walk, const BagReadOptions& options) {
   options.Validate();
   const std::optional<TfChain> chain = ParseTfTopic(options.topic);
-  if (chain) return ReadTfTrajectory(path, *chain, options.record_time, Walk, container);
+  if (chain) return ReadTfTrajectory(path, *chain, options.record_time, walk);
 
   std::map<uint64_t, Kind> wanted;
   std::vector<TopicInfo> seen;
@@ -222,7 +230,7 @@ traj::Trajectory ReadBagTrajectory(const std::string& path, const BagReadOptions
                          fmt::format("topic '{}' message {} ({})", options.topic, count, type_found));
     Decode(wanted[id], reader, log_time_ns, &samples);
   };
-  Walk(path, container, visitor);
+  walk(visitor);
   if (wanted.empty()) {
     std::sort(seen.begin(), seen.end(), [](const TopicInfo& a, const TopicInfo& b) { return a.name < b.name; });
     seen.erase(std::unique(seen.begin(), seen.end(), [](const TopicInfo& a, const TopicInfo& b) {

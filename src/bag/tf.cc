@@ -81,8 +81,7 @@ std::optional<TfChain> ParseTfTopic(const std::string& topic) {
   return chain;
 }
 
-traj::Trajectory ReadTfTrajectory(const std::string& path, const TfChain& chain, bool record_time, WalkFunction walk,
-                                  Container container) {
+traj::Trajectory ReadTfTrajectory(const std::string& path, const TfChain& chain, bool record_time, const Walker& walk) {
   std::map<std::string, Edge> edges;  // child frame -> edge from its parent
   std::map<uint64_t, std::pair<Encoding, bool>> wanted;  // connection -> (encoding, static)
   std::set<std::string> topics;
@@ -137,7 +136,7 @@ traj::Trajectory ReadTfTrajectory(const std::string& path, const TfChain& chain,
       edge.samples.push_back(t);
     }
   };
-  walk(path, container, visitor);
+  walk(visitor);
   if (!dynamic_found) {
     std::string list;
     for (const std::string& t : topics) list += (list.empty() ? "" : ", ") + t;

@@ -18,14 +18,12 @@ struct TfChain {
 // part after ':' is not two frame names separated by one '.'.
 std::optional<TfChain> ParseTfTopic(const std::string& topic);
 
-using WalkFunction = void (*)(const std::string& path, Container container, const Visitor& visitor);
 
 // The poses of `chain.child` in `chain.parent` at the stamps of the child's own (or, when that edge is
 // static, its nearest dynamic ancestor's) transforms, tf2's interpolation between transforms of each
 // edge (linear translation, slerp rotation); stamps outside an edge's recorded span are skipped, as
 // evo skips tf2's extrapolation errors. ComputeError when the frames are not connected or no stamp
 // can be looked up; InputError when the topic is missing or holds no TFMessage.
-traj::Trajectory ReadTfTrajectory(const std::string& path, const TfChain& chain, bool record_time, WalkFunction walk,
-                                  Container container);
+traj::Trajectory ReadTfTrajectory(const std::string& path, const TfChain& chain, bool record_time, const Walker& walk);
 
 }  // namespace cheval::bag
