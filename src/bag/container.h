@@ -55,11 +55,14 @@ std::string ReadFileBytes(const std::string& path);
 std::string Decompress(std::string_view compression, std::string_view data, uint64_t size, const std::string& path,
                        const std::string& what);
 
-// A little-endian cursor over bytes that throws InputError naming `what` on a read past the end.
+// A little-endian cursor over bytes that throws InputError on a read past the end, naming what it
+// reads as `PREFIX LABEL NUMBER` ("chunk at byte 4109: record at byte 70"); the name is formatted
+// only on failure (a cursor is made per record and per message).
 class Cursor {
  public:
-  Cursor(std::string_view bytes, const std::string& path, std::string what)
-      : bytes_(bytes), path_(path), what_(std::move(what)) {}
+  Cursor(std::string_view bytes, const std::string& path, std::string_view label, int64_t number = -1,
+         std::string_view prefix = {})
+      : bytes_(bytes), path_(path), label_(label), prefix_(prefix), number_(number) {}
 
   size_t position() const { return position_; }
   size_t remaining() const { return bytes_.size() - position_; }
@@ -86,7 +89,9 @@ class Cursor {
     if (offset != 0) Skip(n - offset);
   }
   [[noreturn]] void Fail(const std::string& problem) const {
-    throw InputError(path_, 0, 0, fmt::format("{}: {}", what_, problem));
+    const std::string what = number_ >= 0 ? fmt::format("{}{} {}", prefix_, label_, number_)
+                                          : fmt::format("{}{}", prefix_, label_);
+    throw InputError(path_, 0, 0, fmt::format("{}: {}", what, problem));
   }
 
  private:
@@ -98,7 +103,9 @@ class Cursor {
 
   std::string_view bytes_;
   const std::string& path_;
-  std::string what_;
+  std::string_view label_;
+  std::string_view prefix_;
+  int64_t number_;
   size_t position_ = 0;
 };
 

@@ -47,18 +47,17 @@ class McapReader {
  private:
   // Reads records until the end of `bytes` (or DataEnd at the top level). Returns false at DataEnd.
   bool Records(std::string_view bytes, size_t base, const std::string& where) {
-    Cursor cursor(bytes, path_, "");
+    Cursor cursor(bytes, path_, "records");
     while (!cursor.done()) {
       const size_t offset = base + cursor.position();
       if (where.empty() && bytes.size() - cursor.position() == kMagic.size() &&
           bytes.substr(cursor.position()) == kMagic) {
         return false;  // the closing magic of a file without DataEnd/footer
       }
-      Cursor head(bytes.substr(cursor.position()), path_, fmt::format("{}record at byte {}", where, offset));
+      Cursor head(bytes.substr(cursor.position()), path_, "record at byte", static_cast<int64_t>(offset), where);
       const uint8_t op = head.Read<uint8_t>();
       const uint64_t length = head.Read<uint64_t>();
-      const std::string what = fmt::format("{}record at byte {} (opcode {:#04x})", where, offset, op);
-      Cursor content(head.Bytes(length), path_, what);
+      Cursor content(head.Bytes(length), path_, "record at byte", static_cast<int64_t>(offset), where);
       cursor.Skip(9 + length);
       switch (op) {
         case kSchema: {

@@ -11,8 +11,10 @@ namespace cheval::bag {
 // then fields aligned to their size from the end of the header; ROS 1: packed little-endian.
 class MessageReader {
  public:
-  MessageReader(std::string_view data, Encoding encoding, const std::string& path, const std::string& what)
-      : cursor_(data, path, what), cdr_(encoding == Encoding::kCdr) {
+  // Errors name the message as `PREFIX message NUMBER`.
+  MessageReader(std::string_view data, Encoding encoding, const std::string& path, std::string_view prefix,
+                int64_t number)
+      : cursor_(data, path, "message", number, prefix), cdr_(encoding == Encoding::kCdr) {
     if (encoding == Encoding::kUnsupported) cursor_.Fail("the message encoding is neither cdr nor ros1");
     if (cdr_) {
       const std::string_view header = cursor_.Bytes(4);

@@ -224,10 +224,10 @@ traj::Trajectory ReadTrajectoryWith(const std::string& path, const Walker& walk,
     return true;
   };
   int64_t count = 0;
+  std::string prefix;  // "topic 'NAME' (TYPE) "
   visitor.on_message = [&](uint64_t id, int64_t log_time_ns, std::string_view data) {
-    ++count;
-    MessageReader reader(data, encodings[id], path,
-                         fmt::format("topic '{}' message {} ({})", options.topic, count, type_found));
+    if (++count == 1) prefix = fmt::format("topic '{}' ({}) ", options.topic, type_found);
+    MessageReader reader(data, encodings[id], path, prefix, count);
     Decode(wanted[id], reader, log_time_ns, &samples);
   };
   walk(visitor);
@@ -244,9 +244,9 @@ traj::Trajectory ReadTrajectoryWith(const std::string& path, const Walker& walk,
   }
   const Kind kind = wanted.begin()->second;
   // Record-time order, as evo reads (a Path's poses keep their order).
-  if (kind != Kind::kPath) {
-    std::stable_sort(samples.begin(), samples.end(),
-                     [](const Sample& a, const Sample& b) { return a.log_time_ns < b.log_time_ns; });
+  const auto by_log_time = [](const Sample& a, const Sample& b) { return a.log_time_ns < b.log_time_ns; };
+  if (kind != Kind::kPath && !std::is_sorted(samples.begin(), samples.end(), by_log_time)) {
+    std::stable_sort(samples.begin(), samples.end(), by_log_time);
   }
   traj::Channels channels;
   channels.velocity = channels.angular_velocity = kind == Kind::kOdometry;

@@ -39,8 +39,8 @@ const char* OpName(int op) {
 
 // The fields of a record header (or of a connection record's data), as views into the bytes.
 struct Fields {
-  std::string_view names[16];
-  std::string_view values[16];
+  std::string_view names[12];
+  std::string_view values[12];
   int size = 0;
 
   std::string_view Get(std::string_view name) const {
@@ -75,15 +75,15 @@ class RecordReader {
   Record Next() {
     Record record;
     record.offset = base_ + position_;
-    Cursor cursor(bytes_.substr(position_), path_, fmt::format("{}record at byte {}", where_, record.offset));
+    Cursor cursor(bytes_.substr(position_), path_, "record at byte", static_cast<int64_t>(record.offset), where_);
     const uint32_t header_length = cursor.Read<uint32_t>();
-    Cursor header(cursor.Bytes(header_length), path_, fmt::format("{}record header at byte {}", where_, record.offset));
+    Cursor header(cursor.Bytes(header_length), path_, "record header at byte", static_cast<int64_t>(record.offset), where_);
     while (!header.done()) {
       const uint32_t field_length = header.Read<uint32_t>();
       const std::string_view field = header.Bytes(field_length);
       const size_t equals = field.find('=');
       if (equals == std::string_view::npos) header.Fail("a header field has no '='");
-      if (record.fields.size == 16) header.Fail("more than 16 header fields");
+      if (record.fields.size == 12) header.Fail("more than 12 header fields");
       record.fields.names[record.fields.size] = field.substr(0, equals);
       record.fields.values[record.fields.size] = field.substr(equals + 1);
       ++record.fields.size;
@@ -155,7 +155,7 @@ class Ros1Reader {
         AddConnection(record, "");
       } else if (record.op == kChunkInfo) {
         const uint64_t chunk_pos = FieldValue<uint64_t>(record, "chunk_pos", path_, "");
-        Cursor data(record.data, path_, fmt::format("chunk info record at byte {}", record.offset));
+        Cursor data(record.data, path_, "chunk info record at byte", static_cast<int64_t>(record.offset));
         std::set<uint32_t>& conns = chunk_connections_[chunk_pos];
         while (!data.done()) {
           conns.insert(data.Read<uint32_t>());
@@ -209,7 +209,7 @@ class Ros1Reader {
     Connection connection;
     connection.topic = std::string(record.fields.Get("topic"));
     // The data is a run of fields like a record header.
-    Cursor data(record.data, path_, fmt::format("{}connection record at byte {}", where, record.offset));
+    Cursor data(record.data, path_, "connection record at byte", static_cast<int64_t>(record.offset), where);
     while (!data.done()) {
       const uint32_t length = data.Read<uint32_t>();
       const std::string_view field = data.Bytes(length);

@@ -103,7 +103,7 @@ traj::Trajectory ReadTfTrajectory(const std::string& path, const TfChain& chain,
   visitor.on_message = [&](uint64_t id, int64_t log_time_ns, std::string_view data) {
     ++count;
     const auto [encoding, is_static] = wanted[id];
-    MessageReader reader(data, encoding, path, fmt::format("tf message {} (tf2_msgs/TFMessage)", count));
+    MessageReader reader(data, encoding, path, "tf2_msgs/TFMessage ", count);
     const uint32_t n = reader.U32();
     for (uint32_t i = 0; i < n; ++i) {
       std::string_view parent_view;
