@@ -3,6 +3,7 @@
 // record time, Odometry twists turned into world-frame velocities, the last Path, tf chains.
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <tuple>
 
@@ -228,6 +229,31 @@ TEST(TfChain, InterpolatesBetweenStampsOfAnotherEdge) {
   EXPECT_EQ(t.stamps_ns()[0], s / 4);
   EXPECT_NEAR(t.positions()(0, 0), 10.25, 1e-12);
   EXPECT_NEAR(t.positions()(0, 1), 20.75, 1e-12);
+}
+
+}  // namespace
+}  // namespace cheval::bag
+
+namespace cheval::bag {
+namespace {
+
+TEST(Ros2Folder, OfMcapFilesReadsEveryFile) {
+  TempDir dir;
+  const std::string folder = dir / "run";
+  std::filesystem::create_directories(folder);
+  const std::vector<PoseMessage> poses = Helix(30);
+  WriteOptions options;
+  options.container = Container::kMcap;
+  options.compression = "zstd";
+  WriteBag(folder + "/run_0.mcap", {{"/odom", MessageType::kOdometry, {poses.begin(), poses.begin() + 10}}}, options);
+  WriteBag(folder + "/run_1.mcap", {{"/odom", MessageType::kOdometry, {poses.begin() + 10, poses.end()}}}, options);
+  std::ofstream(folder + "/metadata.yaml") << "rosbag2_bagfile_information:\n  version: 8\n  storage_identifier: mcap\n"
+                                              "  compression_format: ''\n  relative_file_paths:\n  - run_0.mcap\n  - run_1.mcap\n";
+  EXPECT_EQ(DetectContainer(folder), Container::kRos2);
+  ExpectPoses(ReadBagTrajectory(folder, {"/odom", false}), poses);
+  const std::vector<TopicInfo> topics = ListTopics(folder);
+  ASSERT_EQ(topics.size(), 1u);
+  EXPECT_EQ(topics[0].count, 30);
 }
 
 }  // namespace
