@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev libceres-dev libcli11-dev nlohmann-json3-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   pybind11-dev python3-dev python3-numpy
+  libsqlite3-dev libzstd-dev liblz4-dev libbz2-dev libyaml-cpp-dev  # recordings (src/bag)
   chromium chromium-driver  # the browser test of `cheval report` (tests/report/browser_test.js)
 )
 

@@ -72,16 +72,18 @@ def _columns_text(columns):
     return columns if isinstance(columns, str) else ",".join(columns)
 
 
-def read(path, format="auto", columns=None, kitti_times=None):
+def read(path, format="auto", columns=None, kitti_times=None, topic=None, bag_time=False):
     """Reads a trajectory file exactly as the CLI does (docs/formats.md) and returns a Trajectory.
 
     format: 'auto' (decided from the content), 'tum', 'tumv', 'euroc', 'kitti', 'vins' or 'csv';
     columns: a column map, e.g. 't_ns,px,py,pz,qw,qx,qy,qz' or a list of role names (implies csv;
     '_' skips a column); kitti_times: a file with one stamp (seconds) per KITTI pose.
+    topic: for a recording (ROS 1 bag, ROS 2 bag folder, MCAP; docs/bags.md) the topic, or
+    '/tf:PARENT.CHILD' for a tf chain; bag_time: stamps from the record time, not the headers.
     Raises InputError ('PATH:LINE:COLUMN: error: ...') for bad input, UsageError for bad arguments.
     """
     return _cheval.read(_path(path), format, _columns_text(columns),
-                        "" if kitti_times is None else _path(kitti_times, "kitti_times"))
+                        "" if kitti_times is None else _path(kitti_times, "kitti_times"), topic or "", bool(bag_time))
 
 
 def write(trajectory, path, format="tum"):

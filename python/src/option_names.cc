@@ -20,6 +20,8 @@ constexpr std::array kKeywords = std::to_array<OptionName>({
     {"ReadOptions::format", "format"},
     {"ReadOptions::columns", "columns"},
     {"ReadOptions::kitti_times_path", "kitti_times"},
+    {"ReadOptions::topic", "topic"},
+    {"ReadOptions::record_time", "bag_time"},
     // eval::AssociationOptions, AlignmentOptions, RpeOptions, EvaluationOptions
     {"AssociationOptions::max_diff_ns", "t_max_diff"},
     {"AssociationOptions::offset_ns", "t_offset"},

@@ -197,8 +197,10 @@ are immutable; the array properties are read-only views of the stored data (no c
   m.def(
       "read",
       [](const std::string& path, const std::string& format, const std::string& columns,
-         const std::string& kitti_times) {
-        const traj::ReadOptions options = traj::ReadOptions::FromNames(format, columns, kitti_times);
+         const std::string& kitti_times, const std::string& topic, bool bag_time) {
+        traj::ReadOptions options = traj::ReadOptions::FromNames(format, columns, kitti_times);
+        options.topic = topic;
+        options.record_time = bag_time;
         PyTrajectory out;
         {
           py::gil_scoped_release release;
@@ -208,11 +210,13 @@ are immutable; the array properties are read-only views of the stored data (no c
         return out;
       },
       py::arg("path"), py::arg("format") = "auto", py::arg("columns") = "", py::arg("kitti_times") = "",
+      py::arg("topic") = "", py::arg("bag_time") = false,
       R"(Reads a trajectory file exactly as the CLI does (docs/formats.md).
 
 format: auto, tum, tumv, euroc, kitti, vins or csv; columns: a column map such as
 't_ns,px,py,pz,qw,qx,qy,qz' (implies csv; '_' skips a column); kitti_times: a file of one stamp
-(seconds) per KITTI pose. Raises InputError ('PATH:LINE:COLUMN: error: ...') on bad input and
+(seconds) per KITTI pose. topic: for a recording (ROS 1 bag, ROS 2 bag folder, MCAP; docs/bags.md),
+the topic or '/tf:PARENT.CHILD'; bag_time: stamps from the record time. Raises InputError ('PATH:LINE:COLUMN: error: ...') on bad input and
 UsageError on bad arguments.)");
 
   m.def(

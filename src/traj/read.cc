@@ -18,6 +18,7 @@
 
 #include <fmt/format.h>
 
+#include "cheval/bag/bag.h"
 #include "cheval/common/error.h"
 #include "cheval/traj/io.h"
 #include "cheval/traj/stamp.h"
@@ -787,7 +788,13 @@ auto WithinMemory(const std::string& path, Read read) -> decltype(read()) {
 }  // namespace
 
 Trajectory ReadTrajectory(const std::string& path, const ReadOptions& options, Format* format_read) {
-  return WithinMemory(path, [&] { return ParseTrajectory(ReadWholeFile(path), path, options, format_read); });
+  return WithinMemory(path, [&] {
+    if (std::optional<Trajectory> recorded = bag::ReadIfRecording(path, options.topic, options.record_time)) {
+      if (format_read != nullptr) *format_read = Format::kAuto;
+      return std::move(*recorded);
+    }
+    return ParseTrajectory(ReadWholeFile(path), path, options, format_read);
+  });
 }
 
 std::vector<int64_t> ReadStampsFile(const std::string& path) {

@@ -28,6 +28,21 @@ void AddInputFlags(CLI::App* command, InputFlags* flags, const std::string& pref
           ""));
   command->add_option(Flag("ReadOptions::kitti_times_path", prefix), flags->kitti_times,
                       "KITTI: file with one stamp (seconds) per pose");
+  command->add_option(Flag("ReadOptions::topic", prefix), flags->topics,
+                      "Recordings (ROS 1/2 bag, MCAP): the topic, or /tf:PARENT.CHILD for a tf chain (docs/bags.md)");
+  command->add_flag(Flag("ReadOptions::record_time", prefix), flags->bag_time,
+                    "Recordings: stamps from the record (log) time instead of the message headers");
+}
+
+traj::ReadOptions InputFlags::ToReadOptions() const {
+  if (topics.size() > 1) {
+    throw UsageError(fmt::format("{} given {} times; only the estimates of ape/rpe/ase/report take several",
+                                 Flag("ReadOptions::topic"), topics.size()));
+  }
+  traj::ReadOptions options = traj::ReadOptions::FromNames(format, columns, kitti_times);
+  if (!topics.empty()) options.topic = topics.front();
+  options.record_time = bag_time;
+  return options;
 }
 
 std::vector<int64_t> ReadQueryStamps(const std::string& path) {

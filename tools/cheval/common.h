@@ -15,14 +15,18 @@
 
 namespace cheval::cli {
 
-/// Flags every command that reads a trajectory takes: --format, --columns, --kitti-times.
+/// Flags every command that reads a trajectory takes: --format, --columns, --kitti-times, and for
+/// recordings --topic (several only for the estimates of an evaluation) and --bag-time.
 struct InputFlags {
   std::string format = "auto";
   std::string columns;
   std::string kitti_times;
+  std::vector<std::string> topics;
+  bool bag_time = false;
 
-  /// The library's options (traj::ReadOptions::FromNames, which validates the combination).
-  traj::ReadOptions ToReadOptions() const { return traj::ReadOptions::FromNames(format, columns, kitti_times); }
+  /// The library's options (traj::ReadOptions::FromNames, which validates the combination) with the
+  /// first topic; UsageError for several topics.
+  traj::ReadOptions ToReadOptions() const;
 };
 
 /// Adds the input flags to `command`; `prefix` allows e.g. --ref-format (empty for --format).

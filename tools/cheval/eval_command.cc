@@ -27,7 +27,39 @@ traj::ReadOptions SideOptions(CLI::App* command, const EvalFlags& flags, const s
   if (given("ReadOptions::format")) merged.format = side.format;
   if (given("ReadOptions::columns")) merged.columns = side.columns;
   if (given("ReadOptions::kitti_times_path")) merged.kitti_times = side.kitti_times;
+  if (given("ReadOptions::topic")) merged.topics = side.topics;
+  if (given("ReadOptions::record_time")) merged.bag_time = side.bag_time;
   return merged.ToReadOptions();
+}
+
+// The estimates to read: each file, or each file with each of several --est-topic (one recording,
+// several estimators), named PATH:TOPIC.
+struct EstimateSource {
+  std::string path, name;
+  traj::ReadOptions options;
+};
+
+std::vector<EstimateSource> EstimateSources(CLI::App* command, const EvalFlags& flags) {
+  InputFlags side = flags.est;
+  const bool per_side = command->get_option(Flag("ReadOptions::topic", "est-"))->count() > 0;
+  const std::vector<std::string> topics = per_side ? flags.est.topics : flags.both.topics;
+  side.topics.clear();
+  InputFlags both = flags.both;
+  both.topics.clear();
+  EvalFlags single = flags;
+  single.est = side;
+  single.both = both;
+  const traj::ReadOptions base = SideOptions(command, single, "est-", side);
+  std::vector<EstimateSource> sources;
+  for (const std::string& path : flags.estimates) {
+    if (topics.empty()) sources.push_back({path, path, base});
+    for (const std::string& topic : topics) {
+      traj::ReadOptions options = base;
+      options.topic = topic;
+      sources.push_back({path, topics.size() > 1 ? path + ":" + topic : path, options});
+    }
+  }
+  return sources;
 }
 
 }  // namespace
@@ -62,14 +94,15 @@ std::vector<std::string> EvalInputPaths(const EvalFlags& flags) {
 
 EvalInputs ReadEvalInputs(CLI::App* command, const EvalFlags& flags) {
   const traj::ReadOptions ref_options = SideOptions(command, flags, "ref-", flags.ref);
-  const traj::ReadOptions est_options = SideOptions(command, flags, "est-", flags.est);
+  const std::vector<EstimateSource> sources = EstimateSources(command, flags);
   // Read the files concurrently (reading dominates the run time); errors are reported in argument order.
   auto ref_future = std::async(std::launch::async, [&] { return traj::ReadTrajectory(flags.reference, ref_options); });
   std::vector<std::future<traj::Trajectory>> est_futures;
-  for (const std::string& path : flags.estimates) {
-    est_futures.push_back(std::async(std::launch::async, [&, path] { return traj::ReadTrajectory(path, est_options); }));
+  for (const auto& source : sources) {
+    est_futures.push_back(std::async(std::launch::async, [&source] { return traj::ReadTrajectory(source.path, source.options); }));
   }
-  EvalInputs inputs{ref_future.get(), {}};
+  EvalInputs inputs{ref_future.get(), {}, {}};
+  for (const auto& source : sources) inputs.estimate_names.push_back(source.name);
   for (auto& f : est_futures) inputs.estimates.push_back(f.get());
   return inputs;
 }
@@ -148,7 +181,7 @@ void Run(CLI::App* command, eval::MetricKind metric, const EvalFlags& flags) {
     Evaluated e;
     e.reference_path = flags.reference;
     e.reference_poses = ref.size();
-    e.estimate_path = flags.estimates[k];
+    e.estimate_path = inputs.estimate_names[k];
     e.estimate_poses = ests[k].size();
     e.options = options;
     e.result = eval::Evaluate(ref.View(), ests[k].View(), options);

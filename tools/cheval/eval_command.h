@@ -55,6 +55,7 @@ eval::EvaluationOptions ToEvaluationOptions(eval::MetricKind metric, const EvalF
 struct EvalInputs {
   traj::Trajectory reference;
   std::vector<traj::Trajectory> estimates;
+  std::vector<std::string> estimate_names;  ///< the paths (PATH:TOPIC for several --est-topic)
 };
 
 /// Every file an evaluation reads: the reference, the estimates and the KITTI times files of both sides

@@ -1,10 +1,12 @@
 // `cheval info FILE...`: what is in a trajectory file, like `evo_traj --full_check`.
+#include <algorithm>
 #include <cstdio>
 
 #include <vector>
 
 #include <fmt/format.h>
 
+#include "cheval/bag/bag.h"
 #include "cheval/traj/stamp.h"
 #include "cheval/traj/summary.h"
 #include "common.h"
@@ -18,9 +20,9 @@ struct InfoFlags {
   std::string json_path;
 };
 
-void PrintSummary(const std::string& path, traj::Format format, const traj::TrajectorySummary& s) {
+void PrintSummary(const std::string& path, const std::string& format, const traj::TrajectorySummary& s) {
   auto line = [](std::string_view key, const std::string& value) { fmt::print("  {:<22}{}\n", key, value); };
-  fmt::print("{} ({})\n", path, traj::ToString(format));
+  fmt::print("{} ({})\n", path, format);
   line("poses", fmt::format("{}", s.poses));
   if (s.has_stamps) {
     line("duration", fmt::format("{} s  ({} .. {})", traj::FormatSeconds(s.last_stamp_ns - s.first_stamp_ns),
@@ -57,6 +59,14 @@ void PrintSummary(const std::string& path, traj::Format format, const traj::Traj
   line("angular velocity", s.has_angular_velocity ? "yes (body frame)" : "no");
 }
 
+// A recording without --topic: its topics.
+void PrintTopics(const std::string& path, bag::Container container, const std::vector<bag::TopicInfo>& topics) {
+  fmt::print("{} ({} recording, {} topics)\n", path, bag::ToString(container), topics.size());
+  size_t width = 5;
+  for (const bag::TopicInfo& t : topics) width = std::max(width, t.name.size());
+  for (const bag::TopicInfo& t : topics) fmt::print("  {:<{}}  {:>8}  {} ({})\n", t.name, width, t.count, t.type, t.encoding);
+}
+
 }  // namespace
 
 void RegisterInfo(CLI::App& app, Action* action) {
@@ -74,10 +84,19 @@ void RegisterInfo(CLI::App& app, Action* action) {
       const traj::ReadOptions options = flags->input.ToReadOptions();
       std::vector<traj::FileSummary> all;
       for (const std::string& path : flags->paths) {
+        const bag::Container container = bag::DetectContainer(path);
+        if (container != bag::Container::kNone && options.topic.empty()) {
+          PrintTopics(path, container, bag::ListTopics(path));
+          continue;
+        }
         traj::FileSummary& file = all.emplace_back(traj::FileSummary{path, options.format, {}});
         const traj::Trajectory trajectory = traj::ReadTrajectory(path, options, &file.format);
         file.summary = traj::Summarize(trajectory.View());
-        PrintSummary(path, file.format, file.summary);
+        PrintSummary(path,
+                     container == bag::Container::kNone
+                         ? std::string(traj::ToString(file.format))
+                         : fmt::format("{} recording, topic {}", bag::ToString(container), options.topic),
+                     file.summary);
       }
       if (!flags->json_path.empty()) WriteOutput(flags->json_path, traj::SummaryJson(all));
     };

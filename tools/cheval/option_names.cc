@@ -14,6 +14,8 @@ constexpr std::array kFlags = std::to_array<OptionName>({
     {"ReadOptions::format", "--format"},
     {"ReadOptions::columns", "--columns"},
     {"ReadOptions::kitti_times_path", "--kitti-times"},
+    {"ReadOptions::topic", "--topic"},
+    {"ReadOptions::record_time", "--bag-time"},
     // eval::AssociationOptions, AlignmentOptions, RpeOptions, EvaluationOptions
     {"AssociationOptions::max_diff_ns", "--t-max-diff"},
     {"AssociationOptions::offset_ns", "--t-offset"},

@@ -28,7 +28,7 @@ void Run(CLI::App* command, const ReportFlags& flags) {
   const EvalInputs inputs = ReadEvalInputs(command, flags.eval);
   std::vector<report::ReportInput> estimates;
   for (size_t k = 0; k < inputs.estimates.size(); ++k) {
-    estimates.push_back({flags.eval.estimates[k], inputs.estimates[k].View()});
+    estimates.push_back({inputs.estimate_names[k], inputs.estimates[k].View()});
   }
   const report::Report result =
       report::BuildReport({flags.eval.reference, inputs.reference.View()}, estimates, options);

@@ -69,6 +69,12 @@ struct ReadOptions {
   std::optional<ColumnMap> columns;
   /// KITTI only: a file with one stamp (seconds) per pose. Without it, KITTI poses have no stamps.
   std::string kitti_times_path;
+  /// Recordings (ROS 1 bags, ROS 2 bag folders, MCAP; recognised by their magic bytes whatever the
+  /// format, docs/bags.md): the topic to read, e.g. `groundtruth` or `/tf:odom.base_link`. Required
+  /// for a recording, refused for a text file.
+  std::string topic;
+  /// Recordings: stamps from the recorder's log time instead of the message headers.
+  bool record_time = false;
 
   /// The options from the names the faces take: `format` a Format name ("auto", "tum", ...), `columns`
   /// a column map spec (ColumnMap::Parse; implies csv; empty for none), `kitti_times_path` as the

@@ -1,0 +1,116 @@
+// ROS 2 bag folders: metadata.yaml (rosbag2_bagfile_information) naming the storage (sqlite3 or mcap)
+// and the files, relative to the folder. sqlite3 files hold the tables `topics` (id, name, type,
+// serialization_format) and `messages` (topic_id, timestamp, data); messages are CDR.
+#include <sqlite3.h>
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <map>
+#include <memory>
+
+#include "container.h"
+
+namespace cheval::bag {
+namespace {
+
+void ReadSqlite(const std::string& path, const Visitor& visitor, uint64_t file_index) {
+  sqlite3* raw = nullptr;
+  if (!std::filesystem::is_regular_file(path)) throw InputError(path, 0, 0, "cannot open the file (named by metadata.yaml)");
+  const int opened = sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr);
+  std::unique_ptr<sqlite3, decltype(&sqlite3_close)> db(raw, sqlite3_close);
+  auto fail = [&](const std::string& what) {
+    throw InputError(path, 0, 0, fmt::format("{}: {}", what, raw != nullptr ? sqlite3_errmsg(raw) : "cannot open"));
+  };
+  if (opened != SQLITE_OK) fail("not a readable sqlite3 database");
+  auto prepare = [&](const char* sql, const std::string& what) {
+    sqlite3_stmt* statement = nullptr;
+    if (sqlite3_prepare_v2(raw, sql, -1, &statement, nullptr) != SQLITE_OK) fail(what);
+    return std::unique_ptr<sqlite3_stmt, decltype(&sqlite3_finalize)>(statement, sqlite3_finalize);
+  };
+  // Connection ids are unique over the files of the folder: file index in the high bits.
+  const uint64_t base = file_index << 40;
+  std::map<int64_t, bool> wanted;
+  {
+    auto topics = prepare("SELECT id, name, type, serialization_format FROM topics", "table 'topics'");
+    int status;
+    while ((status = sqlite3_step(topics.get())) == SQLITE_ROW) {
+      const int64_t id = sqlite3_column_int64(topics.get(), 0);
+      Connection c;
+      auto text = [&](int column) {
+        const unsigned char* t = sqlite3_column_text(topics.get(), column);
+        return t == nullptr ? std::string() : std::string(reinterpret_cast<const char*>(t));
+      };
+      c.topic = text(1);
+      c.type = text(2);
+      const std::string format = text(3);
+      c.encoding = format == "cdr" ? Encoding::kCdr : Encoding::kUnsupported;
+      wanted[id] = visitor.on_connection(base + static_cast<uint64_t>(id), c);
+    }
+    if (status != SQLITE_DONE) fail("table 'topics'");
+  }
+  auto messages = prepare("SELECT topic_id, timestamp, data FROM messages ORDER BY id", "table 'messages'");
+  int status;
+  while ((status = sqlite3_step(messages.get())) == SQLITE_ROW) {
+    const int64_t topic = sqlite3_column_int64(messages.get(), 0);
+    const auto it = wanted.find(topic);
+    if (it == wanted.end()) {
+      throw InputError(path, 0, 0, fmt::format("table 'messages': topic_id {} is not in table 'topics'", topic));
+    }
+    if (!it->second) continue;
+    const int64_t time = sqlite3_column_int64(messages.get(), 1);
+    const void* blob = sqlite3_column_blob(messages.get(), 2);
+    const int size = sqlite3_column_bytes(messages.get(), 2);
+    visitor.on_message(base + static_cast<uint64_t>(topic), time,
+                       std::string_view(static_cast<const char*>(blob), static_cast<size_t>(size)));
+  }
+  if (status != SQLITE_DONE) fail("table 'messages'");
+}
+
+}  // namespace
+
+void ReadRos2(const std::string& folder, const Visitor& visitor) {
+  const std::filesystem::path metadata_path = std::filesystem::path(folder) / "metadata.yaml";
+  const std::string metadata_name = metadata_path.string();
+  YAML::Node info;
+  try {
+    info = YAML::LoadFile(metadata_name)["rosbag2_bagfile_information"];
+  } catch (const YAML::Exception& e) {
+    throw InputError(metadata_name, e.mark.line + 1, e.mark.column + 1, fmt::format("not YAML: {}", e.msg));
+  }
+  try {
+    if (!info || !info.IsMap()) throw InputError(metadata_name, 0, 0, "no 'rosbag2_bagfile_information' map");
+    const std::string storage = info["storage_identifier"] ? info["storage_identifier"].as<std::string>() : "sqlite3";
+    const std::string compression = info["compression_format"] ? info["compression_format"].as<std::string>() : "";
+    if (!compression.empty()) {
+      throw InputError(metadata_name, 0, 0, fmt::format("compression_format '{}': compressed ROS 2 bags are not read; "
+                                                        "decompress it first (ros2 bag convert)",
+                                                        compression));
+    }
+    if (storage != "sqlite3" && storage != "mcap") {
+      throw InputError(metadata_name, 0, 0, fmt::format("storage_identifier '{}': expected sqlite3 or mcap", storage));
+    }
+    const YAML::Node files = info["relative_file_paths"];
+    if (!files || !files.IsSequence() || files.size() == 0) {
+      throw InputError(metadata_name, 0, 0, "no 'relative_file_paths' list");
+    }
+    uint64_t index = 0;
+    for (const YAML::Node& file : files) {
+      const std::string path = (std::filesystem::path(folder) / file.as<std::string>()).string();
+      if (storage == "mcap") {
+        // Channel ids of several files are kept apart the same way.
+        const uint64_t base = index << 40;
+        Visitor shifted;
+        shifted.on_connection = [&](uint64_t id, const Connection& c) { return visitor.on_connection(base + id, c); };
+        shifted.on_message = [&](uint64_t id, int64_t t, std::string_view d) { visitor.on_message(base + id, t, d); };
+        ReadMcap(path, shifted);
+      } else {
+        ReadSqlite(path, visitor, index);
+      }
+      ++index;
+    }
+  } catch (const YAML::Exception& e) {
+    throw InputError(metadata_name, e.mark.line + 1, e.mark.column + 1, fmt::format("unexpected content: {}", e.msg));
+  }
+}
+
+}  // namespace cheval::bag
