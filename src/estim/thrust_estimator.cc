@@ -337,6 +337,8 @@ ThrustEstimate EstimateThrust(const ThrustFlight& flight, const ThrustEstimateOp
     }
     tp.push_back(t[i]);
     pp.push_back(noisy);
+    // A rate far above the samples' would take ~1e11 steps to the next sample: jump there at once.
+    if (t[i] + 1e-9 - next > 1000.0 * period) next += std::floor((t[i] + 1e-9 - next) / period - 1.0) * period;
     while (next <= t[i] + 1e-9) next += period;
   }
   if (tp.size() < 3) throw ComputeError(fmt::format("only {} position measurements: need at least 3", tp.size()));

@@ -132,6 +132,16 @@ TEST(ThrustEstimator, NoisyPositionsAndTheAccelerometer) {
   EXPECT_EQ(imu.imu_measurements, static_cast<int>(flight.samples.size()));
 }
 
+// A position rate far above the flight's sample rate takes every sample (the ticks between two
+// samples are skipped at once; before, ~1e11 steps per sample at 1e9 Hz).
+TEST(ThrustEstimator, APositionRateAboveTheSampleRateTakesEverySample) {
+  const estim::ThrustFlight flight = SimulatedFlight(sim::QuadrotorScenario::kFigureEight, 2.0);
+  estim::ThrustEstimateOptions options;
+  options.position_rate_hz = 1e9;
+  const estim::ThrustEstimate e = estim::EstimateThrust(flight, options);
+  EXPECT_EQ(e.position_measurements, static_cast<int>(flight.samples.size()));
+}
+
 TEST(ThrustEstimator, RejectsBadOptions) {
   const estim::ThrustFlight flight = SimulatedFlight(sim::QuadrotorScenario::kHover, 1.0);
   estim::ThrustEstimateOptions o;
