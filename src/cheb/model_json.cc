@@ -35,7 +35,9 @@ constexpr int64_t kMaxSpanNs = int64_t{1} << 53;
 // writes -0.0 as "-0", which JSON readers take for the integer 0: write it as "-0.0" (found by
 // fuzz_model; tests/data/fuzz/model/negative_zero_value.json).
 std::string Number(double x) {
-  if (!std::isfinite(x)) throw std::invalid_argument("WriteModelJson: non-finite number in the model");
+  if (!std::isfinite(x)) {
+    throw ComputeError("the model holds a number that is not finite: the values are too large to fit");
+  }
   if (x == 0 && std::signbit(x)) return "-0.0";
   return fmt::format("{}", x);
 }

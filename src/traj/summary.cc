@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cheval/common/error.h"
 #include "cheval/traj/stamp.h"
 
 namespace cheval::traj {
@@ -55,6 +56,9 @@ TrajectorySummary Summarize(const TrajectoryView& trajectory) {
     }
     dts.push_back(ToSeconds(dt));
     if (!trajectory.has_velocity() && trajectory.has_stamps()) speeds.push_back(step / ToSeconds(dt));
+  }
+  if (!std::isfinite(s.path_length_m)) {
+    throw ComputeError("the path length is not a finite number: the coordinates are too large to compute with");
   }
   s.dt_s = ComputeBasicStats(dts);
   if (s.dt_s.n > 0) {

@@ -131,6 +131,13 @@ TEST_F(LimitsCliTest, NonFiniteResultsAreExitThreeWithTheReason) {
     ExpectFails(command + " " + Path("huge.txt") + " " + Path("small.txt") + " --json " + Path("out"), 3,
                 "is inf, not a finite number: the coordinates are too large to compute with");
   }
+  // info's path length and compress's model: null and exit 70 before.
+  {
+    std::ofstream vast(Path("vast.txt"));
+    for (int i = 0; i < 20; ++i) vast << 1.0 + 0.1 * i << " " << (i % 2 ? 1.7e308 : -1.7e308) << " 0 0 0 0 0 1\n";
+  }
+  ExpectFails("info " + Path("vast.txt") + " --json " + Path("out"), 3, "the path length is not a finite number");
+  ExpectFails("compress " + Path("huge.txt") + " -o " + Path("model.json"), 3, "not finite");
 }
 
 // Results written to a full standard output were lost with exit 0 (a short output) or exit 70 (a long
