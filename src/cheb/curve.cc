@@ -604,6 +604,21 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     curve.outlier_times_.push_back(t[i]);
   }
   for (const Eigen::Index b : jumps.breaks) curve.jump_times_.push_back(0.5 * (t[b] + t[b + 1]));
+  // Steps leave the samples after them (sorted numbering, before outliers go) and return in the values.
+  curve.step_offsets_.resize(static_cast<Eigen::Index>(jumps.steps.size()), z.cols());
+  {
+    Eigen::RowVectorXd offset = Eigen::RowVectorXd::Zero(z.cols());
+    size_t next = 0;
+    for (Eigen::Index i = 0; i < m; ++i) {
+      if (next < jumps.steps.size() && jumps.steps[next].first == i - 1) {
+        offset += jumps.steps[next].second.transpose();
+        curve.step_times_.push_back(0.5 * (t[i - 1] + t[i]));
+        curve.step_offsets_.row(static_cast<Eigen::Index>(next)) = offset;
+        ++next;
+      }
+      z.row(i) -= offset;
+    }
+  }
   // The samples fitted, and the boundaries in their numbering (a boundary after sample b becomes
   // one after the last kept sample up to b).
   std::vector<Eigen::Index> fitted_index(static_cast<size_t>(m));
@@ -735,6 +750,12 @@ void Curve::EvaluateVelocity(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value
   EvaluateUpTo(stamp_ns, 1, value, &derivative, nullptr, tolerance_s);
 }
 
+template <typename Row>
+void Curve::AddSteps(double t, Row&& value) const {
+  const auto k = std::upper_bound(step_times_.begin(), step_times_.end(), t) - step_times_.begin();
+  if (k > 0) value += step_offsets_.row(k - 1);
+}
+
 Curve::Placement Curve::Locate(double t, double tolerance_s) const {
   // The segment containing t (or nearest within the tolerance).
   const CurveSegment* segment = nullptr;
@@ -796,6 +817,7 @@ void Curve::EvaluateUpTo(int64_t stamp_ns, int order, Eigen::Ref<Eigen::VectorXd
     p = (1.0 - s) * p + s * pr;
   }
   value = p;
+  AddSteps(t, value.transpose());
   if (order >= 1) *derivative = v;
   if (order >= 2) *second_derivative = a;
 }
@@ -855,6 +877,7 @@ void Curve::EvaluateMany(std::span<const int64_t> stamps_ns, int order, Eigen::M
     const Eigen::Index i = sorted[r];
     if (q.right == nullptr) {
       values->row(i) = left[0].row(r);
+      AddSteps(t[r], values->row(i));
       if (order >= 1) first->row(i) = left[1].row(r);
       if (order >= 2) second->row(i) = left[2].row(r);
       continue;
@@ -862,6 +885,7 @@ void Curve::EvaluateMany(std::span<const int64_t> stamps_ns, int order, Eigen::M
     const double s = q.s, ds = q.ds, dds = q.dds;
     const auto dp = right[0].row(r) - left[0].row(r);
     values->row(i) = (1.0 - s) * left[0].row(r) + s * right[0].row(r);
+    AddSteps(t[r], values->row(i));
     if (order >= 1) first->row(i) = (1.0 - s) * left[1].row(r) + s * right[1].row(r) + ds * dp;
     if (order >= 2) {
       second->row(i) = (1.0 - s) * left[2].row(r) + s * right[2].row(r) +

@@ -6,6 +6,9 @@
 #include <numeric>
 #include <optional>
 
+#include <Eigen/LU>
+#include <Eigen/QR>
+
 namespace cheval::cheb::internal {
 namespace {
 
@@ -19,6 +22,12 @@ constexpr int kSkip = 1;
 constexpr double kThreshold = 6.0;
 // Slopes per block of the local scale (robust: the median of a block).
 constexpr Eigen::Index kBlock = 64;
+// Samples on either side of a step that estimate it (RefineSteps).
+constexpr Eigen::Index kStepSamples = 8;
+// A step whose fit finds a jump of the rate this many standard errors away from none is a break.
+constexpr double kRateJumpScore = 3.0;
+// Passes over the slopes, each with the local scale taken again.
+constexpr int kPasses = 8;
 
 class SlopeScan {
  public:
@@ -50,6 +59,12 @@ class SlopeScan {
   }
 
   Eigen::Index size() const { return n_; }
+  // The samples' noise σ in coordinate c (never below a rounding level of the values).
+  double SampleNoise(Eigen::Index c) const { return noise_floor_[c] / std::sqrt(2.0); }
+  // The local scale of slope j's departures in coordinate c (never below the slope noise).
+  double LocalScale(Eigen::Index j, Eigen::Index c, const Eigen::MatrixXd& scale) const {
+    return std::max(scale(j / kBlock, c), noise_floor_[c] / dt_[j]);
+  }
   bool Usable(Eigen::Index j) const { return !cut_[static_cast<size_t>(j)] && !masked_[static_cast<size_t>(j)]; }
   void Cut(Eigen::Index j) { cut_[static_cast<size_t>(j)] = 1; }
   void Mask(Eigen::Index j) { masked_[static_cast<size_t>(j)] = 1; }
@@ -76,8 +91,7 @@ class SlopeScan {
     if (departure != nullptr) *departure = *e;
     double score = 0.0;
     for (Eigen::Index c = 0; c < d_; ++c) {
-      const double s = std::max(scale(j / kBlock, c), noise_floor_[c] / dt_[j]);
-      score = std::max(score, std::abs((*e)[c]) / s);
+      score = std::max(score, std::abs((*e)[c]) / LocalScale(j, c, scale));
     }
     return score;
   }
@@ -192,6 +206,68 @@ class SlopeScan {
   Eigen::VectorXd noise_floor_;
 };
 
+// Each step again, from the samples themselves: a cubic through kStepSamples samples on either
+// side plus the step, least squares, the other steps in reach taken out first (the slope-based
+// estimate carries its lines' prediction error). The same fit with a jump of the rate as well tells
+// whether the rate goes on across: when that jump is significant in any coordinate
+// (kRateJumpScore standard errors, with the residual variance never below the samples' noise
+// variance: a noise-free fit's rounding is not evidence), the step is a break after all.
+void RefineSteps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<Eigen::Index>& gaps,
+                 const SlopeScan& scan, Jumps& jumps) {
+  const Eigen::Index m = t.size();
+  std::vector<char> left_out(static_cast<size_t>(m), 0), cut(static_cast<size_t>(m), 0);
+  for (const Eigen::Index i : jumps.outliers) left_out[static_cast<size_t>(i)] = 1;
+  for (const Eigen::Index b : gaps) cut[static_cast<size_t>(b)] = 1;
+  for (const Eigen::Index b : jumps.breaks) cut[static_cast<size_t>(b)] = 1;
+  std::vector<char> rate_jumps(jumps.steps.size(), 0);
+  for (size_t k = 0; k < jumps.steps.size(); ++k) {
+    const Eigen::Index b = jumps.steps[k].first;
+    Eigen::Index first = b, last = b + 1;  // samples [first, last], not across a cut
+    while (first > 0 && b - first + 1 < kStepSamples && !cut[static_cast<size_t>(first - 1)]) --first;
+    while (last + 1 < m && last - b < kStepSamples && !cut[static_cast<size_t>(last)]) ++last;
+    std::vector<Eigen::Index> used;
+    for (Eigen::Index i = first; i <= last; ++i) {
+      if (!left_out[static_cast<size_t>(i)]) used.push_back(i);
+    }
+    const auto rows = static_cast<Eigen::Index>(used.size());
+    if (rows < 10) continue;
+    const double centre = 0.5 * (t[b] + t[b + 1]), half = 0.5 * (t[last] - t[first]);
+    Eigen::MatrixXd a(rows, 6);
+    Eigen::MatrixXd y(rows, z.cols());
+    for (Eigen::Index r = 0; r < rows; ++r) {
+      const Eigen::Index i = used[static_cast<size_t>(r)];
+      const double u = (t[i] - centre) / half, after = i > b ? 1.0 : 0.0;
+      a.row(r) << 1.0, u, u * u, u * u * u, after, after * u;
+      y.row(r) = z.row(i);
+      for (size_t o = 0; o < jumps.steps.size(); ++o) {  // the other steps between this one and sample i
+        const Eigen::Index s = jumps.steps[o].first;
+        if (o == k) continue;
+        if (s < b && i <= s) y.row(r) += jumps.steps[o].second.transpose();
+        if (s > b && i > s) y.row(r) -= jumps.steps[o].second.transpose();
+      }
+    }
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> with_rate(a);
+    const Eigen::MatrixXd full = with_rate.solve(y);
+    const Eigen::MatrixXd inverse = (a.transpose() * a).inverse();
+    for (Eigen::Index c = 0; c < z.cols(); ++c) {
+      const double variance = std::max((y.col(c) - a * full.col(c)).squaredNorm() / static_cast<double>(rows - 6),
+                                       scan.SampleNoise(c) * scan.SampleNoise(c));
+      if (std::abs(full(5, c)) > kRateJumpScore * std::sqrt(variance * inverse(5, 5))) rate_jumps[k] = 1;
+    }
+    jumps.steps[k].second = a.leftCols(5).colPivHouseholderQr().solve(y).row(4).transpose();
+  }
+  std::vector<std::pair<Eigen::Index, Eigen::VectorXd>> steps;
+  for (size_t k = 0; k < jumps.steps.size(); ++k) {
+    if (rate_jumps[k]) {
+      jumps.breaks.push_back(jumps.steps[k].first);
+    } else {
+      steps.push_back(std::move(jumps.steps[k]));
+    }
+  }
+  jumps.steps = std::move(steps);
+  std::sort(jumps.breaks.begin(), jumps.breaks.end());
+}
+
 }  // namespace
 
 Jumps FindJumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<Eigen::Index>& gaps,
@@ -199,11 +275,13 @@ Jumps FindJumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
   Jumps jumps;
   if (t.size() < 2 * (kSide + kSkip) + 2) return jumps;
   SlopeScan scan(t, z, gaps, noise);
-  const Eigen::MatrixXd scale = scan.Scales();
   const Eigen::Index n = scan.size();
   // Strongest first: a jump's own slope outranks the neighbours it disturbs. Each candidate is
   // scored again just before it is judged (earlier findings change its neighbours' lines).
-  for (int pass = 0; pass < 4; ++pass) {
+  // The local scale is taken again each pass, without the slopes found so far: dense defects (a
+  // correction every few samples) inflate the first pass's scale and hide all but the largest.
+  for (int pass = 0; pass < kPasses; ++pass) {
+    const Eigen::MatrixXd scale = scan.Scales();
     std::vector<std::pair<double, Eigen::Index>> candidates;
     for (Eigen::Index j = 0; j < n; ++j) {
       const double score = scan.Score(j, scale);
@@ -234,9 +312,18 @@ Jumps FindJumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
         scan.Mask(j);
         scan.Mask(*partner);
       } else {
+        // The motion jumps between samples b and b + 1. When slope b alone departs while both
+        // sides' lines agree, the rate goes on across: a step of the values, taken out (slope b is
+        // left out of its neighbours' lines). Otherwise the rate jumps too: split there.
         const Eigen::Index b = scan.LocateBreak(j, scale);
-        jumps.breaks.push_back(b);  // the motion jumps between samples b and b + 1
-        scan.Cut(b);
+        Eigen::VectorXd eb, disagreement_b;
+        if (scan.Score(b, scale, &eb, &disagreement_b) > kThreshold && disagreement_b.norm() <= 0.5 * eb.norm()) {
+          jumps.steps.emplace_back(b, eb * scan.dt(b));
+          scan.Mask(b);
+        } else {
+          jumps.breaks.push_back(b);
+          scan.Cut(b);
+        }
       }
       changed = true;
     }
@@ -244,6 +331,8 @@ Jumps FindJumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
   }
   std::sort(jumps.outliers.begin(), jumps.outliers.end());
   std::sort(jumps.breaks.begin(), jumps.breaks.end());
+  std::sort(jumps.steps.begin(), jumps.steps.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  RefineSteps(t, z, gaps, scan, jumps);
   return jumps;
 }
 

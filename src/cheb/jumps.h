@@ -5,6 +5,7 @@
 // between consecutive samples, d_j = (z_{j+1} − z_j)/(t_{j+1} − t_j), each compared with straight
 // lines fitted to its neighbours on either side; docs/velocity.md, "Jumps and glitches".
 
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -14,9 +15,14 @@ namespace cheval::cheb::internal {
 struct Jumps {
   /// Samples to leave out of the fit (glitches), ascending.
   std::vector<Eigen::Index> outliers;
-  /// Boundaries b (ascending) where the motion jumps between samples b and b + 1: the fit is split
-  /// there as at a gap.
+  /// Boundaries b (ascending) where the motion jumps between samples b and b + 1 and its rate does
+  /// not go on across (an impact, or a jump too close to another to tell): the fit is split there
+  /// as at a gap.
   std::vector<Eigen::Index> breaks;
+  /// Boundaries b (ascending) where the values step between samples b and b + 1 while the rate goes
+  /// on across (a correction of filtered ground truth): b and the step, to be taken out of the
+  /// samples after b before fitting and added back to the curve's values.
+  std::vector<std::pair<Eigen::Index, Eigen::VectorXd>> steps;
 };
 
 /// t: sorted times (s), z: m x d samples, gaps: boundaries b that are already gaps (not crossed by

@@ -312,6 +312,7 @@ std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimat
     j["unresolved_windows"] = curve.unresolved_windows();
     j["outliers"] = curve.outlier_times().size();
     j["jumps"] = curve.jump_times().size();
+    j["steps"] = curve.step_times().size();
   }
   if (estimate.rotation_curve) {
     j["angular"] = {{"charts", estimate.rotation_curve->charts().size()},

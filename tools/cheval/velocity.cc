@@ -76,10 +76,10 @@ void Run(const VelocityFlags& flags) {
   if (const std::string warning = eval::UnresolvedWarning(curve); !warning.empty()) {
     fmt::print(stderr, "cheval: warning: {}: {}\n", flags.input, warning);
   }
-  if (!curve.outlier_times().empty() || !curve.jump_times().empty()) {
-    fmt::print(stderr, "cheval: note: {}: {} sample(s) left out as outliers, split at {} jump(s) (--json lists the "
-               "windows; docs/velocity.md, \"Jumps and glitches\")\n",
-               flags.input, curve.outlier_times().size(), curve.jump_times().size());
+  if (!curve.outlier_times().empty() || !curve.jump_times().empty() || !curve.step_times().empty()) {
+    fmt::print(stderr, "cheval: note: {}: {} sample(s) left out as outliers, {} step(s) of the positions taken out, "
+               "split at {} jump(s) (--json lists the windows; docs/velocity.md, \"Jumps and glitches\")\n",
+               flags.input, curve.outlier_times().size(), curve.step_times().size(), curve.jump_times().size());
   }
   size_t windows = 0;
   int min_degree = curve.segments().front().windows.front().degrees.front(), max_degree = min_degree;

@@ -69,9 +69,10 @@ struct CurveOptions {
   /// Fit a single window over each gap-free segment (no splitting), e.g. to reproduce a global fit.
   bool single_window = false;
   /// Find isolated defects before fitting (docs/velocity.md, "Jumps and glitches"): a sample
-  /// displaced from both of its neighbours is left out of the fit (an outlier), and a jump of the
-  /// values or of their rate between two samples splits the data there as a gap does, so that
-  /// neither spreads over a window. Only departures far beyond the local scatter count (6 local
+  /// displaced from both of its neighbours is left out of the fit (an outlier); a step of the
+  /// values between two samples across which the rate goes on is taken out of the samples and
+  /// added back to the curve's values (its derivatives do not see it); a jump of the rate splits the
+  /// data there as a gap does. None of them spreads over a window. Only departures far beyond the local scatter count (6 local
   /// scales): on clean data next to nothing is found. false fits every sample as given.
   bool robust = true;
   /// A window is accepted only when its residual is consistent with the noise too (the
@@ -172,6 +173,10 @@ class Curve {
   /// split at (midway between the two samples), CurveOptions::robust.
   const std::vector<double>& outlier_times() const { return outlier_times_; }
   const std::vector<double>& jump_times() const { return jump_times_; }
+  /// Times (s from the origin, midway between the two samples) of the steps of the values taken
+  /// out before fitting (CurveOptions::robust); the curve's values include them, its derivatives
+  /// do not.
+  const std::vector<double>& step_times() const { return step_times_; }
   /// The windows that were accepted unresolved (WindowVerdict::kUnresolved).
   Eigen::Index unresolved_windows() const;
 
@@ -193,7 +198,12 @@ class Curve {
   std::vector<CurveSegment> segments_;
   Eigen::VectorXd noise_sigma_;
   Eigen::VectorXd residual_rms_;
-  std::vector<double> outlier_times_, jump_times_;
+  std::vector<double> outlier_times_, jump_times_, step_times_;
+  // Row k: the sum of the first k + 1 steps, added to values after step_times_[k].
+  Eigen::MatrixXd step_offsets_;
+  // Adds the steps before time t to a value.
+  template <typename Row>
+  void AddSteps(double t, Row&& value) const;
 };
 
 /// Quintic smoothstep s(u) = 6u⁵ − 15u⁴ + 10u³ on u clamped to [0, 1], with ds/du and d²s/du²:
