@@ -117,6 +117,11 @@ void VelocityOptions::Validate() const {
   }
   check(!angular || method != VelocityMethod::kSavitzkyGolay, "angular",
         "works with VelocityOptions::method chebyshev or central, not {}", ToString(method));
+  // A constant has no rate: degree 0 would give zero velocity everywhere, whatever the motion.
+  OptionCheck("CurveOptions")(method != VelocityMethod::kChebyshev ||
+                                  curve.degree_method != cheb::DegreeMethod::kFixed || curve.fixed_degree >= 1,
+        "fixed_degree", "must be >= 1 for a velocity (degree 0 is a constant, its rate is zero), got {}",
+        curve.fixed_degree);
 }
 
 namespace {

@@ -256,6 +256,10 @@ TEST_F(CliTest, VelocityBadInput) {
   EXPECT_NE(degree.err.find("degree 50 needs at least 51 distinct stamps per window"), std::string::npos);
   EXPECT_EQ(Cheval("velocity " + Path("short.txt") + " --method magic").exit_code, 1);
   EXPECT_EQ(Cheval("velocity " + Path("short.txt") + " --degree lots").exit_code, 1);
+  // Degree 0 is a constant: a velocity of zero whatever the motion, refused rather than written.
+  RunResult constant = Cheval("velocity " + Path("short.txt") + " --degree 0 -o " + Path("out.txt"));
+  EXPECT_EQ(constant.exit_code, 1);
+  EXPECT_NE(constant.err.find("--degree must be >= 1 for a velocity"), std::string::npos) << constant.err;
   EXPECT_EQ(Cheval("velocity " + Path("short.txt") + " --method central --at " + Path("short.txt")).exit_code, 1);
   EXPECT_EQ(Cheval("velocity " + cheval::testing::FixturePath("bad/nan.txt") + " -o " + Path("out.txt")).exit_code, 2);
   EXPECT_FALSE(fs::exists(Path("out.txt")));

@@ -45,7 +45,8 @@ struct VelocityOptions {
   bool angular = false;
 
   /// Throws OptionError for a Savitzky–Golay window that is not an odd number >= 5 of samples or not
-  /// a positive number of seconds, and for angular with kSavitzkyGolay.
+  /// a positive number of seconds, for angular with kSavitzkyGolay, and for a fixed Chebyshev degree
+  /// of 0 (a constant: its velocity is zero whatever the motion).
   void Validate() const;
 };
 
