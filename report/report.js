@@ -218,7 +218,7 @@
   }
 
   function distributions() {
-    const row = el('div', { class: 'row' });
+    const row = el('div', { class: 'row four' });
     document.getElementById('distributions').append(row);
     distributionCharts(row, 'ape_distribution', 'APE', estimates[0].ape.metric.unit || 'unit-less');
     distributionCharts(row, 'ase_distribution', 'ASE', 'unit-less');

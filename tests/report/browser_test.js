@@ -177,15 +177,27 @@ async function main() {
       const [download] = await Promise.all([tab.waitForEvent('download'), tab.click(`#chart-${chart} button[data-export="${kind}"]`)]);
       return { name: download.suggestedFilename(), bytes: fs.readFileSync(await download.path()) };
     }
-    for (const chart of ['ape', 'trajectory-top', 'rpe-box-trans', 'ape-violin']) {
-      const svg = await exported(chart, 'svg');
-      const text = svg.bytes.toString();
-      check(svg.name === `${chart}.svg` && text.startsWith('<svg') && /<(path|rect|line)/.test(text) && text.includes('</svg>'), `${chart}.svg is an SVG with shapes (${svg.bytes.length} bytes)`);
-      const csv = await exported(chart, 'csv');
-      const lines = csv.bytes.toString().trim().split('\n');
-      check(csv.name === `${chart}.csv` && lines.length >= 3 && lines.every((l) => l.split(',').length >= lines[0].split(',').length - 0), `${chart}.csv has a header and rows (${lines.length} lines: ${lines[0]})`);
-      const png = await exported(chart, 'png');
-      check(png.bytes.subarray(1, 4).toString() === 'PNG' && png.bytes.length > 5000, `${chart}.png is a PNG (${png.bytes.length} bytes)`);
+    // The buttons download the files (one chart, the three kinds); every chart's exports are then
+    // made by the same functions the buttons call, in the page.
+    const downloads = {};
+    for (const kind of ['svg', 'csv', 'png']) downloads[kind] = await exported('ape', kind);
+    check(downloads.svg.name === 'ape.svg' && downloads.svg.bytes.toString().startsWith('<svg'), `the SVG button downloads ape.svg (${downloads.svg.bytes.length} bytes)`);
+    check(downloads.csv.name === 'ape.csv' && downloads.csv.bytes.toString().startsWith('time (s),'), `the CSV button downloads ape.csv (${downloads.csv.bytes.length} bytes)`);
+    check(downloads.png.name === 'ape.png' && downloads.png.bytes.subarray(1, 4).toString() === 'PNG', `the PNG button downloads ape.png (${downloads.png.bytes.length} bytes)`);
+    const exports = await tab.evaluate(async () => {
+      const out = [];
+      for (const c of window.chevalReport.charts) {
+        const svg = c.svg(), csv = c.csv().trim().split('\n');
+        const png = await ChevalCharts.pngOf(svg);
+        const head = new Uint8Array(await png.slice(0, 4).arrayBuffer());
+        out.push({ id: c.id, svg: svg.startsWith('<svg') && /<(path|rect|line)/.test(svg) && svg.endsWith('</svg>'), svgBytes: svg.length,
+          csvLines: csv.length, columns: csv[0].split(',').length, png: String.fromCharCode(...head.slice(1, 4)) === 'PNG', pngBytes: png.size });
+      }
+      return out;
+    });
+    check(exports.length === expected.length + 2, `every chart exports (${exports.length} charts with the fit diagnostics)`);
+    for (const e of exports) {
+      check(e.svg && e.csvLines >= 3 && e.png && e.pngBytes > 3000, `${e.id}: SVG with shapes (${e.svgBytes} B), CSV ${e.csvLines} lines x ${e.columns} columns, PNG ${e.pngBytes} B`);
     }
 
     // The table shows the embedded statistics (the numbers of `cheval ape --json`, checked by report_cli_test).
