@@ -317,7 +317,8 @@ const ChevalCharts = (function () {
       scales: { x: { time: false, auto: false, range: () => ranges.x }, y: { auto: false, range: () => ranges.y } },
       axes: [{ label: spec.axes[0] + ' (m)' }, { label: spec.axes[1] + ' (m)', size: 64 }],
       series: [{}, ...paths.map((p, k) => ({
-        label: p.label, stroke: colorBy && colorBy.index === k ? 'rgba(0,0,0,0.08)' : p.color, width: p.width || 1.25,
+        // Coloured by error: that path in the colour map over the others, faded.
+        label: p.label, stroke: colorBy && k > 0 ? (colorBy.index === k ? 'rgba(0,0,0,0.08)' : p.color + '30') : p.color, width: p.width || 1.25,
         paths: polyline, points: { show: false }, facets: [{ scale: 'x', auto: false }, { scale: 'y', auto: false }],
       }))],
       legend: { live: false, ...legendMarkers([null, ...paths.map((p) => p.color)]) },
@@ -326,6 +327,11 @@ const ChevalCharts = (function () {
     }, [null, ...paths.map((p) => [p.x, p.y])], entry.plot);
     setPlot(entry, chart, countPoints(paths.map((p) => p.x)));
     entry.plot.append(chart.root);
+    if (colorBy) {
+      const gradient = [0, 0.25, 0.5, 0.75, 1].map((t) => colormap(t)).join(', ');
+      entry.plot.append(el('p', { class: 'colorbar' }, `${colorBy.label} of ${paths[colorBy.index].label}: ${v0.toPrecision(3)} `,
+        el('span', { class: 'gradient', style: `background: linear-gradient(to right, ${gradient})` }), ` ${v1.toPrecision(3)}`));
+    }
     entry.svg = () => {
       const shown = paths.map((p, k) => ({ p, k })).filter(({ k }) => chart.series[k + 1].show);
       const items = [];

@@ -151,7 +151,7 @@
       parent.append(el('p', { class: 'chart-note', id: 'ase-absent', text: 'No estimate has an ASE: its charts are not shown. ' + missing }));
       return;
     }
-    const parts = [['total', 'ASE on SE_2(3) (unit-less)', 'ASE'], ['rotation_deg', 'ASE rotation part, angle of R_qᵀR_p (°)', 'rotation (°)'],
+    const parts = [['total', 'ASE on SE_2(3) (unit-less)', 'ASE'], ['rotation_deg', 'ASE rotation part (°)', 'rotation (°)'],
       ['position', 'ASE position part (m)', 'position (m)'], ['velocity', 'ASE velocity part (m/s)', 'velocity (m/s)']];
     const row = el('div', { class: 'row three' });
     for (const [key, title, axis] of parts) {

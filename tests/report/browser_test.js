@@ -130,6 +130,8 @@ async function main() {
     const colored = await tab.evaluate(() => window.chevalReport.charts.find((c) => c.id === 'trajectory-top').svg());
     check((colored.match(/<line [^>]*stroke="rgb\(/g) || []).length > 500 && colored.includes('APE (m)'), 'colour by APE draws the path in the colour map with a colour bar');
     check(colored.includes('<circle') && colored.includes('<rect x='), 'the top view has start and end markers');
+    fs.mkdirSync(outputDir, { recursive: true });
+    await (await tab.$('#chart-trajectory-top')).screenshot({ path: path.join(outputDir, 'report_top_view_error.png') });
     await tab.click('#trajectory-controls button[data-choice="none"]');
 
     // The ASE rotation part in degrees.
