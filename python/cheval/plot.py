@@ -147,7 +147,8 @@ def distribution(ref, estimates, *, kind="box", metric="ape", align="se3", **opt
     evaluate = {"ape": cheval.ape, "ase": cheval.ase}[metric]
     options = _options(align, options)
     listed = _estimates(estimates)
-    values = [np.asarray(evaluate(ref, est, errors=True, **options)["errors"]["error"]) for _, est in listed]
+    results = [evaluate(ref, est, errors=True, **options) for _, est in listed]
+    values = [np.asarray(r["errors"]["error"]) for r in results]
     fig = Figure(figsize=(1.6 + 1.2 * len(listed), 4.0), constrained_layout=True)
     ax = fig.add_subplot()
     positions = np.arange(1, len(listed) + 1)
@@ -160,7 +161,7 @@ def distribution(ref, estimates, *, kind="box", metric="ape", align="se3", **opt
         for k, body in enumerate(parts["bodies"]):
             body.set(facecolor=_COLORS[k % len(_COLORS)], alpha=0.35)
     ax.set_xticks(positions, [label for label, _ in listed])
-    ax.set_ylabel(f"{metric.upper()} ({'m' if metric == 'ape' and options.get('relation', 'trans_part') in ('trans_part', 'point_distance') else 'see relation'})")
+    ax.set_ylabel(f"{metric.upper()} ({results[0]['metric']['unit'] or 'unit-less'})")
     return fig
 
 

@@ -92,6 +92,13 @@ class PlotTest(unittest.TestCase):
         self.assertEqual(len(lines["vio_a.txt"].get_ydata()), ape["association"]["pairs"])
         box = cp.distribution(self.ref, [self.a, self.b], kind="box")
         self.assertEqual([t.get_text() for t in box.axes[0].get_xticklabels()], ["vio_a.txt", "vio_b.txt"])
+        self.assertEqual(box.axes[0].get_ylabel(), "APE (m)")
+        degrees = cp.distribution(self.ref, self.a, relation="angle_deg")
+        self.assertEqual(degrees.axes[0].get_ylabel(), "APE (deg)")
+        # The box's median line is the APE's median.
+        median = [line for line in box.axes[0].get_lines() if len(line.get_ydata()) == 2
+                  and line.get_ydata()[0] == line.get_ydata()[1]]
+        self.assertTrue(any(abs(line.get_ydata()[0] - ape["stats"]["median"]) < 1e-12 for line in median))
         violin = cp.distribution(self.ref, [self.a, self.b], kind="violin")
         self.assertEqual(len(violin.axes[0].collections) >= 2, True)
         with self.assertRaises(cheval.UsageError):
