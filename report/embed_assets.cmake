@@ -24,7 +24,17 @@ function(cheval_bytes var file end_tag)
 endfunction()
 
 cheval_bytes(page_template "${PAGE_TEMPLATE}" "")
-cheval_bytes(page_script "${PAGE_SCRIPT}" "</script")
+# PAGE_SCRIPT: the page's scripts separated by '|', embedded one after the other as one script.
+string(REPLACE "|" ";" page_scripts "${PAGE_SCRIPT}")
+set(page_script "{")
+foreach(script IN LISTS page_scripts)
+  cheval_bytes(bytes "${script}" "</script")
+  string(LENGTH "${bytes}" length)
+  math(EXPR length "${length} - 6")  # without "{" and "0x00}"
+  string(SUBSTRING "${bytes}" 1 ${length} bytes)
+  string(APPEND page_script "${bytes}0x0a,\n")
+endforeach()
+string(APPEND page_script "0x00}")
 cheval_bytes(page_style "${PAGE_STYLE}" "</style")
 cheval_bytes(chart_script "${CHART_SCRIPT}" "</script")
 cheval_bytes(chart_style "${CHART_STYLE}" "</style")

@@ -18,7 +18,10 @@ option(CHEVAL_BUILD_REPORT "Embed the HTML report's chart library (uPlot, instal
 set(CHEVAL_REPORT_SOURCES
   ${PROJECT_SOURCE_DIR}/src/report/decimate.cc
   ${PROJECT_SOURCE_DIR}/src/report/report.cc
-  ${PROJECT_SOURCE_DIR}/src/report/html.cc)
+  ${PROJECT_SOURCE_DIR}/src/report/html.cc
+  ${PROJECT_SOURCE_DIR}/src/report/distribution.cc
+  ${PROJECT_SOURCE_DIR}/src/report/series.cc
+  ${PROJECT_SOURCE_DIR}/src/report/sections.cc)
 
 if(CHEVAL_BUILD_REPORT)
   if(NOT CHEVAL_NPM_EXECUTABLE)
@@ -49,14 +52,14 @@ if(CHEVAL_BUILD_REPORT)
             -DOUTPUT=${report_build}/report_assets.cc
             -DASSETS_HEADER=${PROJECT_SOURCE_DIR}/src/report/assets.h
             -DPAGE_TEMPLATE=${report_source}/page.html
-            -DPAGE_SCRIPT=${report_source}/report.js
+            -DPAGE_SCRIPT=${report_source}/charts.js|${report_source}/report.js
             -DPAGE_STYLE=${report_source}/report.css
             -DCHART_SCRIPT=${uplot}/dist/uPlot.iife.min.js
             -DCHART_STYLE=${uplot}/dist/uPlot.min.css
             -DCHART_PACKAGE=${uplot}/package.json
             -P ${report_source}/embed_assets.cmake
     DEPENDS ${CHEVAL_REPORT_NODE_MODULES}/.package-lock.json ${report_source}/embed_assets.cmake
-            ${report_source}/page.html ${report_source}/report.js ${report_source}/report.css
+            ${report_source}/page.html ${report_source}/charts.js ${report_source}/report.js ${report_source}/report.css
     COMMENT "Embedding the report page and uPlot"
     VERBATIM)
   list(APPEND CHEVAL_REPORT_SOURCES ${report_build}/report_assets.cc)

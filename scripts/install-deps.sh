@@ -10,6 +10,7 @@ packages=(
   pybind11-dev python3-dev python3-numpy
   libsqlite3-dev libzstd-dev liblz4-dev libbz2-dev libyaml-cpp-dev  # recordings (src/bag)
   chromium chromium-driver  # the browser test of `cheval report` (tests/report/browser_test.js)
+  python3-matplotlib  # cheval.plot, figures for papers (python/cheval/plot.py)
 )
 
 # The report's chart library comes from the npm registry at build time: the machine's Node.js and npm

@@ -10,7 +10,7 @@ namespace cheval::report::detail {
 
 struct PageAssets {
   std::string_view page_template;  ///< report/page.html, with {{NAME}} markers
-  std::string_view page_script;    ///< report/report.js
+  std::string_view page_script;    ///< report/charts.js then report/report.js
   std::string_view page_style;     ///< report/report.css
   std::string_view chart_script;   ///< the chart library's minified script
   std::string_view chart_style;    ///< and its styles

@@ -1,7 +1,7 @@
 #include "cheval/report/report.h"
 
 #include <algorithm>
-#include <charconv>
+#include <filesystem>
 #include <cmath>
 #include <numeric>
 #include <optional>
@@ -17,105 +17,26 @@
 #include "cheval/common/options.h"
 #include "cheval/eval/pairs.h"
 #include "cheval/eval/velocity.h"
-#include "cheval/report/decimate.h"
+#include "sections.h"
+#include "series.h"
 
 namespace cheval::report {
 namespace {
 
-using Json = nlohmann::ordered_json;
-
-// A plotted value with `digits` significant digits: its shortest form is then short (the page draws
-// pixels; the statistics are embedded at full precision). Not finite -> NaN, which the JSON writes
-// as null (a gap).
-double Rounded(double value, int digits = 6) {
-  if (!std::isfinite(value)) return std::nan("");
-  char text[32];
-  const auto written = std::to_chars(text, text + sizeof text, value, std::chars_format::general, digits);
-  double rounded = value;
-  std::from_chars(text, written.ptr, rounded);
-  return rounded;
-}
-
-// Seconds from the report's time origin, to the microsecond.
-double SecondsFrom(int64_t origin_ns, int64_t stamp_ns) {
-  return std::round(static_cast<double>(stamp_ns - origin_ns) / 1e3) / 1e6;  // divisions: the nearest double
-}
-
-// A series over time for the page: {"t": [...], name: [...], ...}, sorted by time, decimated by
-// min/max buckets over all columns together (MinMaxDecimation).
-Json TimeSeries(const std::vector<double>& t, const std::vector<std::pair<std::string, std::vector<double>>>& columns,
-                std::size_t max_points) {
-  std::vector<Eigen::Index> order(t.size());
-  std::iota(order.begin(), order.end(), Eigen::Index{0});
-  std::stable_sort(order.begin(), order.end(), [&](Eigen::Index a, Eigen::Index b) { return t[a] < t[b]; });
-  std::vector<std::vector<double>> sorted;
-  for (const auto& column : columns) {
-    std::vector<double>& s = sorted.emplace_back(order.size());
-    for (size_t i = 0; i < order.size(); ++i) s[i] = column.second[static_cast<size_t>(order[i])];
-  }
-  const std::vector<std::span<const double>> views(sorted.begin(), sorted.end());
-  const std::vector<Eigen::Index> kept = MinMaxDecimation(views, max_points);
-  Json series;
-  Json& times = series["t"] = Json::array();
-  for (Eigen::Index i : kept) times.push_back(t[static_cast<size_t>(order[static_cast<size_t>(i)])]);
-  for (size_t c = 0; c < columns.size(); ++c) {
-    Json& values = series[columns[c].first] = Json::array();
-    for (Eigen::Index i : kept) values.push_back(Rounded(sorted[c][static_cast<size_t>(i)]));
-  }
-  series["n"] = t.size();  // samples before decimation
-  return series;
-}
+using detail::Clock;
+using detail::Json;
+using detail::Rounded;
+using detail::TimeSeries;
 
 // Columns vx, vy, vz and speed of 3 x n velocities.
-std::vector<std::pair<std::string, std::vector<double>>> VelocityColumns(const Eigen::Ref<const Eigen::Matrix3Xd>& v) {
-  std::vector<std::pair<std::string, std::vector<double>>> columns = {
-      {"vx", {}}, {"vy", {}}, {"vz", {}}, {"speed", {}}};
+detail::Columns VelocityColumns(const Eigen::Ref<const Eigen::Matrix3Xd>& v) {
+  detail::Columns columns = {{"vx", {}}, {"vy", {}}, {"vz", {}}, {"speed", {}}};
   for (Eigen::Index i = 0; i < v.cols(); ++i) {
     for (int axis = 0; axis < 3; ++axis) columns[axis].second.push_back(v(axis, i));
     columns[3].second.push_back(v.col(i).norm());
   }
   return columns;
 }
-
-// A path in space for the page, {"x": [...], "y": [...], "z": [...]}, decimated by a stride
-// (StrideDecimation): a path has no value whose extremes a user looks for.
-Json Path(const Eigen::Ref<const Eigen::Matrix3Xd>& positions, std::size_t max_points) {
-  Json path;
-  const char* names[3] = {"x", "y", "z"};
-  const std::vector<Eigen::Index> kept = StrideDecimation(positions.cols(), max_points);
-  for (int axis = 0; axis < 3; ++axis) {
-    Json& values = path[names[axis]] = Json::array();
-    for (Eigen::Index i : kept) values.push_back(Rounded(positions(axis, i)));
-  }
-  path["n"] = positions.cols();
-  return path;
-}
-
-// The report's clock: seconds from the reference's first stamp, or the pose index without stamps.
-struct Clock {
-  bool stamps = true;
-  int64_t origin_ns = 0;
-
-  // Times of the poses of a trajectory whose stamps plus `offset_ns` are reference stamps.
-  std::vector<double> Poses(const traj::TrajectoryView& trajectory, int64_t offset_ns = 0) const {
-    std::vector<double> t(static_cast<size_t>(trajectory.size()));
-    for (Eigen::Index i = 0; i < trajectory.size(); ++i) {
-      t[static_cast<size_t>(i)] = stamps && trajectory.has_stamps()
-                                      ? SecondsFrom(origin_ns, trajectory.stamps_ns()[i] + offset_ns)
-                                      : static_cast<double>(i);
-    }
-    return t;
-  }
-  // Times of the pairs of a result: the paired reference stamps.
-  std::vector<double> Pairs(const eval::EvaluationResult& result, const traj::TrajectoryView& ref) const {
-    const traj::TrajectoryView paired = result.continuous_reference ? result.continuous_reference->View() : ref;
-    std::vector<double> t(static_cast<size_t>(result.association.size()));
-    for (size_t k = 0; k < t.size(); ++k) {
-      t[k] = stamps ? SecondsFrom(origin_ns, paired.stamps_ns()[result.association.ref[k]]) : static_cast<double>(k);
-    }
-    return t;
-  }
-};
 
 // The estimate's states with an alignment applied, every pose (not only the paired ones).
 struct AlignedStates {
@@ -139,6 +60,7 @@ AlignedStates Aligned(const traj::TrajectoryView& est, const eval::Similarity& a
   return out;
 }
 
+// `reference` and `estimate` carry the names the page shows (Shown) in their path.
 eval::EvaluationReport Evaluated(const ReportInput& reference, const ReportInput& estimate,
                                  const eval::EvaluationOptions& evaluation, eval::MetricKind metric) {
   eval::EvaluationReport e;
@@ -212,7 +134,7 @@ Json ReferenceVelocity(const ReportInput& reference, const ReportOptions& option
   Json velocity = Json::object();
   if (!ref.has_stamps()) {
     notes->push_back(fmt::format("{} has no stamps: its velocity from positions and the Chebyshev fit are not shown",
-                                 reference.path));
+                                 reference.label));
     return velocity;
   }
   const std::vector<double> t = clock.Poses(ref);
@@ -250,8 +172,9 @@ namespace {
 // The memory the plotted series take, before anything is computed: every plotted number is a JSON
 // value, its text in the data and its copy in the page (measured: 36 bytes a value on 200,000-pose
 // files with max_points above that). A series has at most min(its samples, max_points) points; the
-// reference has its path (3 columns) and up to three velocities (t, vx, vy, vz, speed), each estimate
-// its APE series (t, error) and path, and with velocity its ASE series and velocity (5 columns each).
+// reference has its path (7 columns) and up to three velocities (t, vx, vy, vz, speed), each estimate
+// its APE series (t, error), path (t, x, y, z, roll, pitch, yaw, error) and RPE series (t, trans, rot),
+// and with velocity its ASE series and velocity (5 columns each).
 void CheckPlottedMemory(const ReportInput& reference, const std::vector<ReportInput>& estimates,
                         const ReportOptions& options) {
   constexpr double kBytesPerValue = 64;
@@ -259,10 +182,10 @@ void CheckPlottedMemory(const ReportInput& reference, const std::vector<ReportIn
     return static_cast<double>(std::min(static_cast<std::size_t>(std::max<Eigen::Index>(samples, 0)), options.max_points));
   };
   const traj::TrajectoryView& ref = reference.trajectory;
-  double values = points(ref.size()) * (3 + 5 * (ref.has_velocity() ? 3 : 2));
+  double values = points(ref.size()) * (7 + 5 * (ref.has_velocity() ? 3 : 2));
   for (const ReportInput& estimate : estimates) {
     const traj::TrajectoryView& est = estimate.trajectory;
-    values += points(est.size()) * (2 + 3 + (est.has_velocity() ? 10 : 0));
+    values += points(est.size()) * (2 + 8 + 3 + (est.has_velocity() ? 10 : 0));
   }
   CheckMemory({"ReportOptions", "max_points", values * kBytesPerValue,
                fmt::format("{:.4g} plotted values for {} poses of the reference and {} estimate(s)", values, ref.size(),
@@ -289,12 +212,48 @@ std::optional<std::pair<std::string, double>> FirstNonFinite(const Json& json, c
   return std::nullopt;
 }
 
+// Paths and attitude are smooth curves drawn by a stride: half the points of a series over time.
+std::size_t PathPoints(const ReportOptions& options) { return std::max<std::size_t>(options.max_points / 2, 16); }
+
+// The inputs as the page names them: `path` becomes the file path with options.show_paths, else
+// the label; `label` is the given label, else the file name, and default labels that two estimates
+// share get their parent folders until they differ (two runs are often both .../result.csv).
+std::vector<ReportInput> Shown(const std::vector<ReportInput>& inputs, bool show_paths) {
+  std::vector<ReportInput> shown(inputs);
+  std::vector<std::filesystem::path> paths;
+  for (const ReportInput& input : inputs) paths.emplace_back(input.path);
+  for (size_t depth = 1;; ++depth) {
+    bool longer = false;
+    for (size_t i = 0; i < shown.size(); ++i) {
+      if (!inputs[i].label.empty()) continue;
+      std::vector<std::filesystem::path> parts(paths[i].begin(), paths[i].end());
+      std::erase_if(parts, [](const std::filesystem::path& p) { return p.empty() || p == "/"; });
+      const size_t from = parts.size() > depth ? parts.size() - depth : 0;
+      std::filesystem::path tail;
+      for (size_t k = from; k < parts.size(); ++k) tail /= parts[k];
+      shown[i].label = tail.empty() ? inputs[i].path : tail.generic_string();
+      longer = longer || from > 0;
+    }
+    bool distinct = true;
+    for (size_t i = 0; i < shown.size() && distinct; ++i) {
+      for (size_t j = i + 1; j < shown.size(); ++j) distinct = distinct && shown[i].label != shown[j].label;
+    }
+    if (distinct || !longer) break;
+  }
+  for (ReportInput& input : shown) {
+    if (!show_paths) input.path = input.label;
+  }
+  return shown;
+}
+
 }  // namespace
 
-Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>& estimates,
+Report BuildReport(const ReportInput& reference_input, const std::vector<ReportInput>& estimate_inputs,
                    const ReportOptions& options) {
   options.Validate();
-  CheckPlottedMemory(reference, estimates, options);
+  CheckPlottedMemory(reference_input, estimate_inputs, options);
+  const ReportInput reference = Shown({reference_input}, options.show_paths)[0];
+  const std::vector<ReportInput> estimates = Shown(estimate_inputs, options.show_paths);
   const traj::TrajectoryView& ref = reference.trajectory;
   Clock clock;
   clock.stamps = ref.has_stamps() && !ref.empty();
@@ -303,14 +262,20 @@ Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>&
   Report report;
   Json data;
   data["format"] = "cheval-report";
-  data["version"] = 1;
+  data["version"] = 2;
   data["generator"] = options.generator;
-  data["reference"] = {{"path", reference.path},
+  const auto reference_rotation = ref.has_orientation()
+                                      ? std::function<Eigen::Matrix3d(Eigen::Index)>(
+                                            [&](Eigen::Index i) { return ref.Rotation(i); })
+                                      : nullptr;
+  data["reference"] = {{"label", reference.label},
+                       {"path", reference.path},
                        {"poses", ref.size()},
                        {"has_stamps", ref.has_stamps()},
                        {"has_orientation", ref.has_orientation()},
                        {"has_velocity", ref.has_velocity()},
-                       {"path_xyz", Path(ref.positions(), options.max_points)}};
+                       {"path_xyz", detail::PathSeries(ref.positions(), clock.Poses(ref), reference_rotation, nullptr,
+                                                       PathPoints(options))}};
   data["time_axis"] = clock.stamps ? "s" : "index";
   data["time_origin_ns"] = std::to_string(clock.origin_ns);  // a string: int64 does not fit a JavaScript number
   data["options"] = {{"align", std::string(eval::ToString(options.ape.alignment.method))},
@@ -321,7 +286,10 @@ Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>&
                      {"association", options.ape.continuous_reference ? "continuous" : "nearest"},
                      {"gt_velocity", std::string(eval::ToString(options.ase.reference_velocity))},
                      {"velocity_frame", options.ase.estimate_velocity_body_frame ? "body" : "world"},
-                     {"max_points", options.max_points}};
+                     {"max_points", options.max_points},
+                     {"show_paths", options.show_paths}};
+  const std::vector<double> rpe_distances = detail::RpeDistances(ref);
+  data["rpe_distances"] = rpe_distances;
 
   Json entries = Json::array();
   for (const ReportInput& estimate : estimates) {
@@ -329,12 +297,30 @@ Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>&
     const eval::EvaluationReport& ape =
         report.ape.emplace_back(Evaluated(reference, estimate, options.ape, eval::MetricKind::kApe));
     Json entry;
+    entry["label"] = estimate.label;
     entry["path"] = estimate.path;
     entry["poses"] = est.size();
     entry["has_velocity"] = est.has_velocity();
     entry["ape"] = ResultJson(ape);
     entry["ape_series"] = TimeSeries(clock.Pairs(ape.result, ref), {{"error", ape.result.errors}}, options.max_points);
-    entry["path_xyz"] = Path(Aligned(est, ape.result.alignment.transform, false, false).positions, options.max_points);
+    entry["ape_distribution"] = detail::DistributionJson(ape.result.errors);
+    {
+      // Every pose with its APE (NaN when unpaired), for the top view coloured by error.
+      std::vector<double> pose_errors(static_cast<size_t>(est.size()), std::nan(""));
+      for (size_t k = 0; k < ape.result.errors.size(); ++k) {
+        pose_errors[static_cast<size_t>(ape.result.association.est[k])] = ape.result.errors[k];
+      }
+      const eval::Similarity& alignment = ape.result.alignment.transform;
+      const auto rotation = est.has_orientation() ? std::function<Eigen::Matrix3d(Eigen::Index)>([&](Eigen::Index i) {
+        return alignment.ApplyToRotation(est.Rotation(i));
+      })
+                                                  : nullptr;
+      entry["path_xyz"] = detail::PathSeries(Aligned(est, alignment, false, false).positions,
+                                             clock.Poses(est, options.ape.association.offset_ns), rotation,
+                                             &pose_errors, PathPoints(options));
+    }
+    entry["rpe"] = detail::RpeJson(ref, est, ape.result, rpe_distances, clock, options.max_points, estimate.label,
+                                   &report.notes);
     std::optional<eval::EvaluationReport>& ase = report.ase.emplace_back();
     // Why the estimate has no ASE, if it has none.
     std::string absent;
@@ -343,24 +329,29 @@ Report BuildReport(const ReportInput& reference, const std::vector<ReportInput>&
       report.notes.push_back(fmt::format(
           "{} has no velocity: its ASE and velocity are not shown (give a file with velocity columns: tumv, euroc, "
           "vins, or csv with vx,vy,vz)",
-          estimate.path));
+          estimate.label));
     } else {
       try {
         ase = Evaluated(reference, estimate, options.ase, eval::MetricKind::kAse);
       } catch (const ComputeError& e) {
         absent = "no ASE";
-        report.notes.push_back(fmt::format("the ASE of {} cannot be computed, so it is not shown: {}", estimate.path,
+        report.notes.push_back(fmt::format("the ASE of {} cannot be computed, so it is not shown: {}", estimate.label,
                                            SpellOptions(e.what(), options.option_names)));
       }
     }
     if (ase) {
       const eval::AseErrors& parts = *ase->result.ase;
-      std::vector<std::pair<std::string, std::vector<double>>> columns = {{"total", parts.total}};
-      if (parts.has_rotation) columns.push_back({"rotation", parts.rotation});
+      detail::Columns columns = {{"total", parts.total}};
+      if (parts.has_rotation) {
+        std::vector<double> degrees = detail::RotationPartDegrees(parts.rotation);
+        entry["ase_rotation_deg"] = detail::BoxJson(BoxOf(degrees));
+        columns.push_back({"rotation_deg", std::move(degrees)});
+      }
       columns.push_back({"position", parts.position});
       if (parts.has_velocity) columns.push_back({"velocity", parts.velocity});
       entry["ase"] = ResultJson(*ase);
       entry["ase_series"] = TimeSeries(clock.Pairs(ase->result, ref), columns, options.max_points);
+      entry["ase_distribution"] = detail::DistributionJson(parts.total);
     } else {
       entry["ase"] = nullptr;
       entry["ase_absent"] = absent;

@@ -2,9 +2,14 @@
 // report/package-lock.json; it never downloads a browser). Simulates a drone flight with the
 // project's own simulator, makes two estimates with velocity (a noisy 50 Hz copy with `cheval
 // velocity`, and a drifting odometry from `cheval sim motion --estimate`) and one without, writes the report and checks in the
-// browser that it loads with no console error or failed request, that every chart has data, that
-// the table shows the embedded numbers and that the missing velocity is said on the page; then
-// takes a full-page screenshot.
+// browser that it loads with no console error or failed request, that every chart has data (the
+// trajectories, x/y/z and roll/pitch/yaw, APE and ASE over time, the error distributions, the RPE
+// box plots and series, the velocity), that the page names files by label and has no absolute
+// path, that legends stay on one line, the top view is fitted to the data and can be coloured by
+// error, the velocity is scaled to the motion with central differences one click away, the fit
+// diagnostics are collapsed, every chart exports PNG/SVG/CSV, the table shows the embedded numbers
+// and the missing velocity is said on the page; then takes a full-page screenshot and one per
+// section (the figures of docs/report.md).
 //
 //   node browser_test.js CHEVAL_EXE NODE_MODULES OUTPUT_DIR
 //
@@ -77,7 +82,7 @@ async function main() {
     tab.on('console', (m) => { if (m.type() === 'error' || m.type() === 'warning') problems.push(`console ${m.type()}: ${m.text()}`); });
     tab.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
     // A self-contained page requests nothing but itself.
-    tab.on('request', (r) => { if (!r.url().startsWith('file://')) problems.push(`request: ${r.url()}`); });
+    tab.on('request', (r) => { if (!/^(file|blob|data):/.test(r.url())) problems.push(`request: ${r.url()}`); });
     tab.on('requestfailed', (r) => problems.push(`request failed: ${r.url()}`));
     await tab.goto('file://' + page);
     await tab.waitForSelector('body[data-ready], body[data-error]', { timeout: 30000 });
@@ -89,22 +94,113 @@ async function main() {
       id: b.dataset.chart,
       points: Number(b.dataset.points || 0),
       canvas: !!b.querySelector('canvas'),
+      svg: b.querySelectorAll('svg path, svg rect, svg line, svg polygon').length,
     })));
-    const expected = ['trajectory-top', 'trajectory-side', 'ape', 'ase', 'ase-rotation', 'ase-position', 'ase-velocity',
-      'velocity', 'fit-degrees', 'fit-coefficients'];
+    const expected = ['trajectory-top', 'trajectory-side', 'x', 'y', 'z', 'roll', 'pitch', 'yaw', 'ape', 'ase', 'ase-rotation',
+      'ase-position', 'ase-velocity', 'ape-histogram', 'ape-violin', 'ase-histogram', 'ase-violin', 'rpe-box-trans',
+      'rpe-box-rot', 'rpe-trans', 'rpe-rot', 'velocity'];
     check(JSON.stringify(charts.map((c) => c.id)) === JSON.stringify(expected), `the charts are ${expected.join(', ')} (got ${charts.map((c) => c.id).join(', ')})`);
-    for (const c of charts) check(c.points > 0 && c.canvas, `chart ${c.id} is drawn with data (${c.points} points)`);
-    const instances = await tab.evaluate(() => window.chevalReport.charts.map((c) => ({ id: c.id, series: c.plot.series.length, rows: c.plot.data.length })));
-    check(instances.length === expected.length && instances.every((c) => c.series >= 2), 'every chart is a uPlot instance with at least one series');
+    for (const c of charts) check(c.points > 0 && (c.canvas || c.svg > 10), `chart ${c.id} is drawn with data (${c.points} points, ${c.canvas ? 'canvas' : c.svg + ' SVG shapes'})`);
+    const instances = await tab.evaluate(() => window.chevalReport.charts.map((c) => ({ id: c.id, uplot: !!(c.chart && c.chart.series), series: c.chart && c.chart.series ? c.chart.series.length : 0 })));
+    check(instances.filter((c) => c.uplot).every((c) => c.series >= 2), 'every uPlot chart has at least one series');
 
-    // The drawn canvases are not blank: the trajectory's canvas has pixels of the reference's ink.
-    const inked = await tab.$eval('#chart-trajectory-top canvas', (canvas) => {
-      const pixels = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
-      let n = 0;
-      for (let i = 0; i < pixels.length; i += 4) if (pixels[i + 3] > 0) n++;
-      return n;
+    // Labels, never the machine's folders: the page does not contain the work folder.
+    const html = await tab.content();
+    check(!html.includes(work), `the page has no absolute path (${work} absent)`);
+    const legendNames = await tab.$$eval('#chart-ape .u-legend .u-series .u-label', (l) => l.map((x) => x.textContent));
+    check(JSON.stringify(legendNames.slice(1)) === JSON.stringify(['noisy_velocity.tumv', 'drifting.tumv', 'poses_only.tum']), `the legends name the estimates by file name (${legendNames})`);
+    // Legend entries on one line each, with filled swatches.
+    const legend = await tab.$$eval('.u-legend', (legends) => legends.flatMap((table) => [...table.querySelectorAll('.u-series th')].map((c, k) => {
+      const marker = c.querySelector('.u-marker'), label = c.querySelector('.u-label');
+      return { x: k === 0 && !table.closest('[data-chart^="trajectory"]'), h: label.getBoundingClientRect().height, line: parseFloat(getComputedStyle(label).lineHeight), fill: marker ? getComputedStyle(marker).backgroundColor : 'none' };
+    })));
+    check(legend.length > 20 && legend.every((l) => l.h <= l.line + 1), `every legend label is on one line (${legend.length} entries, tallest ${Math.max(...legend.map((l) => l.h))} px, line ${legend[0].line} px)`);
+    check(legend.filter((l) => !l.x).every((l) => l.fill !== 'none' && l.fill !== 'rgba(0, 0, 0, 0)'), 'legend swatches are filled (every series but the x axis)');
+
+    // The top view is fitted to the data: the reference spans ≥ 85 % of the plot in one direction and ≥ 50 % in the other.
+    const fill = await tab.evaluate(() => {
+      const u = window.chevalReport.charts.find((c) => c.id === 'trajectory-top').chart;
+      const p = window.chevalReport.data.reference.path_xyz;
+      const xs = p.x.map((v) => u.valToPos(v, 'x')), ys = p.y.map((v) => u.valToPos(v, 'y'));
+      return [(Math.max(...xs) - Math.min(...xs)) / u.bbox.width * devicePixelRatio, (Math.max(...ys) - Math.min(...ys)) / u.bbox.height * devicePixelRatio];
     });
-    check(inked > 1000, `the top view's canvas has ink (${inked} painted pixels)`);
+    check(Math.max(...fill) >= 0.85 && Math.min(...fill) >= 0.5, `the top view is fitted to the data (spans ${fill.map((f) => f.toFixed(2))})`);
+    // Colour by error: the SVG of the top view has the colour map and its bar.
+    await tab.click('#trajectory-controls button[data-choice="1"]');
+    const colored = await tab.evaluate(() => window.chevalReport.charts.find((c) => c.id === 'trajectory-top').svg());
+    check((colored.match(/<line [^>]*stroke="rgb\(/g) || []).length > 500 && colored.includes('APE (m)'), 'colour by APE draws the path in the colour map with a colour bar');
+    check(colored.includes('<circle') && colored.includes('<rect x='), 'the top view has start and end markers');
+    fs.mkdirSync(outputDir, { recursive: true });
+    await (await tab.$('#chart-trajectory-top')).screenshot({ path: path.join(outputDir, 'report_top_view_error.png') });
+    await tab.click('#trajectory-controls button[data-choice="none"]');
+
+    // The ASE rotation part in degrees.
+    const rotation = await tab.evaluate(() => {
+      const e = window.chevalReport.data.estimates[0];
+      return { deg: !!e.ase_series.rotation_deg, old: 'rotation' in e.ase_series, title: document.querySelector('#chart-ase-rotation h3').textContent };
+    });
+    check(rotation.deg && !rotation.old && rotation.title.includes('°'), `the ASE rotation part is in degrees (${rotation.title})`);
+
+    // Velocity: central differences hidden by default, one click shows them; the range is the motion's.
+    const velocity = await tab.evaluate(() => {
+      const c = window.chevalReport.charts.find((x) => x.id === 'velocity');
+      const central = c.chart.series.findIndex((s) => s.label === 'reference, central diff.');
+      const speeds = window.chevalReport.data.reference_velocity.chebyshev.speed;
+      return { shown: c.chart.series[central].show, top: c.chart.scales.y.max, motion: Math.max(...speeds) };
+    });
+    check(velocity.shown === false, 'central differences are hidden by default');
+    check(velocity.top <= velocity.motion * 1.3, `the velocity chart is scaled to the motion (y max ${velocity.top.toFixed(2)}, speed max ${velocity.motion.toFixed(2)})`);
+    await tab.click('#toggle-central');
+    const centralShown = await tab.evaluate(() => {
+      const c = window.chevalReport.charts.find((x) => x.id === 'velocity');
+      return c.chart.series.find((s) => s.label === 'reference, central diff.').show;
+    });
+    check(centralShown === true, 'one click shows the central differences');
+    await tab.click('#toggle-central');
+
+    // RPE: a box per estimate and distance; the buttons redraw the series over time.
+    const rpe = await tab.evaluate(() => ({ distances: window.chevalReport.data.rpe_distances, boxes: document.querySelectorAll('#chart-rpe-box-trans svg rect[fill-opacity]').length }));
+    check(rpe.distances.length === 5 && rpe.boxes === 5 * 3, `the RPE box plot has 5 distances x 3 estimates (${rpe.boxes} boxes)`);
+    await tab.click(`#rpe button[data-choice="${rpe.distances[2]}"]`);
+    const rpeTitle = await tab.$eval('#chart-rpe-trans h3', (h) => h.textContent);
+    check(rpeTitle.includes(String(rpe.distances[2])) && (await tab.$eval('#chart-rpe-trans', (b) => Number(b.dataset.points))) > 0, `the RPE over time is redrawn at another distance (${rpeTitle})`);
+
+    // Fit diagnostics: collapsed, drawn when opened.
+    check(await tab.$eval('#fit-section', (d) => !d.open) && (await tab.$$('#chart-fit-degrees')).length === 0, 'the fit diagnostics are collapsed and not drawn');
+    await tab.click('#fit-section summary');
+    await tab.waitForSelector('#chart-fit-coefficients[data-points]');
+    const fitPoints = await tab.$$eval('#chart-fit-degrees, #chart-fit-coefficients', (b) => b.map((x) => Number(x.dataset.points)));
+    check(fitPoints.length === 2 && fitPoints.every((n) => n > 0), `opened, the fit charts are drawn (${fitPoints})`);
+
+    // Every chart exports PNG, SVG and CSV; the files are what they say.
+    const exportable = await tab.$$eval('.chart', (boxes) => boxes.every((b) => ['png', 'svg', 'csv'].every((k) => b.querySelector(`button[data-export="${k}"]`))));
+    check(exportable, 'every chart has PNG, SVG and CSV buttons');
+    async function exported(chart, kind) {
+      const [download] = await Promise.all([tab.waitForEvent('download'), tab.click(`#chart-${chart} button[data-export="${kind}"]`)]);
+      return { name: download.suggestedFilename(), bytes: fs.readFileSync(await download.path()) };
+    }
+    // The buttons download the files (one chart, the three kinds); every chart's exports are then
+    // made by the same functions the buttons call, in the page.
+    const downloads = {};
+    for (const kind of ['svg', 'csv', 'png']) downloads[kind] = await exported('ape', kind);
+    check(downloads.svg.name === 'ape.svg' && downloads.svg.bytes.toString().startsWith('<svg'), `the SVG button downloads ape.svg (${downloads.svg.bytes.length} bytes)`);
+    check(downloads.csv.name === 'ape.csv' && downloads.csv.bytes.toString().startsWith('time (s),'), `the CSV button downloads ape.csv (${downloads.csv.bytes.length} bytes)`);
+    check(downloads.png.name === 'ape.png' && downloads.png.bytes.subarray(1, 4).toString() === 'PNG', `the PNG button downloads ape.png (${downloads.png.bytes.length} bytes)`);
+    const exports = await tab.evaluate(async () => {
+      const out = [];
+      for (const c of window.chevalReport.charts) {
+        const svg = c.svg(), csv = c.csv().trim().split('\n');
+        const png = await ChevalCharts.pngOf(svg);
+        const head = new Uint8Array(await png.slice(0, 4).arrayBuffer());
+        out.push({ id: c.id, svg: svg.startsWith('<svg') && /<(path|rect|line)/.test(svg) && svg.endsWith('</svg>'), svgBytes: svg.length,
+          csvLines: csv.length, columns: csv[0].split(',').length, png: String.fromCharCode(...head.slice(1, 4)) === 'PNG', pngBytes: png.size });
+      }
+      return out;
+    });
+    check(exports.length === expected.length + 2, `every chart exports (${exports.length} charts with the fit diagnostics)`);
+    for (const e of exports) {
+      check(e.svg && e.csvLines >= 3 && e.png && e.pngBytes > 3000, `${e.id}: SVG with shapes (${e.svgBytes} B), CSV ${e.csvLines} lines x ${e.columns} columns, PNG ${e.pngBytes} B`);
+    }
 
     // The table shows the embedded statistics (the numbers of `cheval ape --json`, checked by report_cli_test).
     const table = await tab.evaluate(() => {
@@ -123,16 +219,21 @@ async function main() {
     check(aseNote.includes('poses_only.tum'), `the ASE chart names the estimate it leaves out (${aseNote})`);
 
     // The velocity component buttons redraw the chart with data.
-    await tab.click('#velocity-controls button[data-component="vz"]');
+    await tab.click('#velocity-controls button[data-choice="vz"]');
     const vz = await tab.$eval('#chart-velocity', (b) => Number(b.dataset.points));
     check(vz > 0, `the velocity chart redrawn for vz has data (${vz} points)`);
-    await tab.click('#velocity-controls button[data-component="speed"]');
+    await tab.click('#velocity-controls button[data-choice="speed"]');
 
     fs.mkdirSync(outputDir, { recursive: true });
     const screenshot = path.join(outputDir, 'report.png');
     await tab.screenshot({ path: screenshot, fullPage: true });
     const size = fs.statSync(screenshot).size;
     check(size > 50000, `screenshot ${screenshot} written (${size} bytes)`);
+    // One screenshot per section, the figures of docs/report.md.
+    for (const [name, selector] of [['report_top', 'header'], ['report_trajectories', '#trajectories'], ['report_pose', '#pose-charts'],
+      ['report_errors', '#errors'], ['report_distributions', '#distributions'], ['report_rpe', '#rpe'], ['report_velocity', '#velocity']]) {
+      await (await tab.$(selector)).screenshot({ path: path.join(outputDir, name + '.png') });
+    }
     fs.copyFileSync(page, path.join(outputDir, 'report.html'));
 
     // The report of the README's demo data (scripts/demo.sh, steps 1 and 4) renders with every chart.

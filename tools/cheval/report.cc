@@ -1,6 +1,8 @@
 // `cheval report REF EST [EST2 ...] -o report.html`: one self-contained HTML page with the aligned
 // trajectories, APE and ASE over time, velocities, the comparison table and the reference's
 // Chebyshev fit diagnostics (docs/report.md). The evaluation flags are those of ape/ase.
+#include <filesystem>
+
 #include <fmt/format.h>
 
 #include "cheval/report/report.h"
@@ -28,13 +30,15 @@ void Run(CLI::App* command, const ReportFlags& flags) {
   const EvalInputs inputs = ReadEvalInputs(command, flags.eval);
   std::vector<report::ReportInput> estimates;
   for (size_t k = 0; k < inputs.estimates.size(); ++k) {
-    estimates.push_back({inputs.estimate_names[k], inputs.estimates[k].View()});
+    // The label: empty, the file name (report::ReportInput::label).
+    estimates.push_back({inputs.estimate_names[k], inputs.estimates[k].View(), ""});
   }
   const report::Report result =
-      report::BuildReport({flags.eval.reference, inputs.reference.View()}, estimates, options);
+      report::BuildReport({flags.eval.reference, inputs.reference.View(), ""}, estimates, options);
+  const std::string reference_name =
+      options.show_paths ? flags.eval.reference : std::filesystem::path(flags.eval.reference).filename().string();
   const std::string page = report::RenderReportHtml(
-      result.data_json,
-      fmt::format("cheval report: {} estimate(s) against {}", estimates.size(), flags.eval.reference));
+      result.data_json, fmt::format("cheval report: {} estimate(s) against {}", estimates.size(), reference_name));
   WriteOutput(flags.output, page);
 
   for (size_t k = 0; k < result.ape.size(); ++k) {
@@ -68,6 +72,8 @@ void RegisterReport(CLI::App& app, Action* action) {
       ->add_option(Flag("ReportOptions::max_points"), flags->options.max_points,
                    "Most points of one plotted series (min/max buckets over time; the statistics use every pair)")
       ->capture_default_str();
+  command->add_flag("--show-paths", flags->options.show_paths,
+                    "Show the inputs' file paths in the page (default: their file names only)");
   command->callback([command, flags, action] { *action = [command, flags] { Run(command, *flags); }; });
 }
 

@@ -2,9 +2,10 @@
 /// \file
 /// The HTML report of `cheval report REF EST [EST2 ...]` (docs/report.md): one self-contained page
 /// (chart library, page script, styles and data inlined) with the aligned trajectories, APE and ASE
-/// over time, the reference velocity (Chebyshev and central differences, and its own columns)
-/// against each estimate's, the comparison table, and the diagnostics of the reference's Chebyshev
-/// fit. BuildReport computes everything the page shows (the statistics from all pairs; the plotted
+/// over time, their distributions (histogram, box and violin), the RPE at 10..50 % of the reference's
+/// length (over time and as box plots per distance), x/y/z and roll/pitch/yaw over time, the
+/// reference velocity (Chebyshev and central differences, and its own columns) against each
+/// estimate's, the comparison table, and the diagnostics of the reference's Chebyshev fit. BuildReport computes everything the page shows (the statistics from all pairs; the plotted
 /// series decimated, decimate.h); RenderReportHtml writes the page around it.
 
 #include <cstddef>
@@ -20,10 +21,15 @@
 
 namespace cheval::report {
 
-/// A trajectory of the report with the name the page shows (its file path).
+/// A trajectory of the report. The page names it by its label (legends, table, notes); its path
+/// appears in the page only with ReportOptions::show_paths.
 struct ReportInput {
+  /// The file it was read from.
   std::string path;
   traj::TrajectoryView trajectory;
+  /// The short name the page shows; empty: the file name of `path` (with as many parent folders as
+  /// tell two estimates of the same file name apart).
+  std::string label;
 };
 
 /// Options of BuildReport.
@@ -38,6 +44,9 @@ struct ReportOptions {
   /// Most windows of the reference's Chebyshev fit whose coefficient magnitudes are embedded (evenly
   /// spread over the windows; the degrees of every window are embedded).
   std::size_t max_fit_windows = 64;
+  /// Show the inputs' file paths in the page (header, the embedded results' `path`); otherwise
+  /// only labels, so a page shared with others does not carry the machine's folders.
+  bool show_paths = false;
   /// Shown in the page's footer, e.g. "cheval 0.1.0".
   std::string generator;
   /// The caller's spelling of option names in the notes, which quote library messages
