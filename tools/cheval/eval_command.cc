@@ -64,6 +64,33 @@ std::vector<EstimateSource> EstimateSources(CLI::App* command, const EvalFlags& 
 
 }  // namespace
 
+std::string ResolvedAlignment(const EvalFlags& flags) {
+  const bool evo = flags.evo_align || flags.evo_scale || flags.evo_align_origin;
+  if (!evo) return flags.align;
+  if (flags.evo_align_origin && (flags.evo_align || flags.evo_scale)) {
+    throw UsageError("--align_origin with -a/-s: cheval aligns once; give --align origin, or -a/-s alone");
+  }
+  const std::string method = flags.evo_align_origin ? "origin"
+                             : flags.evo_align     ? (flags.evo_scale ? "sim3" : "se3")
+                                                   : "scale";
+  if (flags.align_given && flags.align != method) {
+    throw UsageError(fmt::format("--align {} contradicts evo's alignment flags (-a/-s/--align_origin mean --align {})",
+                                 flags.align, method));
+  }
+  return method;
+}
+
+std::string UnknownFlags(const CLI::App& app, const std::vector<std::string>& arguments) {
+  const std::vector<CLI::App*> commands = app.get_subcommands();
+  const CLI::App* command = commands.empty() ? &app : commands.front();
+  std::vector<std::string> known;
+  for (const CLI::Option* option : command->get_options()) {
+    for (const std::string& name : option->get_lnames()) known.push_back("--" + name);
+    for (const std::string& name : option->get_snames()) known.push_back("-" + name);
+  }
+  return UnknownFlagsMessage(arguments, known, commands.empty() ? "" : command->get_name());
+}
+
 eval::EvaluationOptions ToEvaluationOptions(eval::MetricKind metric, const EvalFlags& flags) {
   eval::EvaluationOptions options = flags.options;
   options.metric = metric;
@@ -76,7 +103,7 @@ eval::EvaluationOptions ToEvaluationOptions(eval::MetricKind metric, const EvalF
   }
   options.association = eval::AssociationOptions::FromSeconds(flags.t_max_diff, flags.t_offset);
   options.continuous_reference = flags.association == "continuous";
-  options.alignment.method = *eval::AlignmentMethodFromString(flags.align);
+  options.alignment.method = *eval::AlignmentMethodFromString(ResolvedAlignment(flags));
   options.relation = *eval::PoseRelationFromString(flags.relation);
   options.rpe.delta_unit = *eval::DeltaUnitFromString(flags.delta_unit);
   options.reference_velocity = *eval::ReferenceVelocitySourceFromString(flags.gt_velocity);
@@ -96,15 +123,37 @@ EvalInputs ReadEvalInputs(CLI::App* command, const EvalFlags& flags) {
   const traj::ReadOptions ref_options = SideOptions(command, flags, "ref-", flags.ref);
   const std::vector<EstimateSource> sources = EstimateSources(command, flags);
   // Read the files concurrently (reading dominates the run time); errors are reported in argument order.
-  auto ref_future = std::async(std::launch::async, [&] { return traj::ReadTrajectory(flags.reference, ref_options); });
+  EvalInputs inputs;
+  inputs.estimate_formats.resize(sources.size());
+  auto ref_future = std::async(std::launch::async, [&] {
+    return traj::ReadTrajectory(flags.reference, ref_options, &inputs.reference_format);
+  });
   std::vector<std::future<traj::Trajectory>> est_futures;
-  for (const auto& source : sources) {
-    est_futures.push_back(std::async(std::launch::async, [&source] { return traj::ReadTrajectory(source.path, source.options); }));
+  for (size_t k = 0; k < sources.size(); ++k) {
+    est_futures.push_back(std::async(std::launch::async, [&sources, &inputs, k] {
+      return traj::ReadTrajectory(sources[k].path, sources[k].options, &inputs.estimate_formats[k]);
+    }));
   }
-  EvalInputs inputs{ref_future.get(), {}, {}};
+  inputs.reference = ref_future.get();
   for (const auto& source : sources) inputs.estimate_names.push_back(source.name);
   for (auto& f : est_futures) inputs.estimates.push_back(f.get());
   return inputs;
+}
+
+namespace {
+
+eval::EvoStampSeconds EvoSecondsOf(traj::Format format) {
+  // evo's EuRoC and pose CSV readers divide integer nanoseconds by 1e9; its text-second formats parse decimals.
+  const bool nanoseconds = format == traj::Format::kEuroc || format == traj::Format::kVins;
+  return nanoseconds ? eval::EvoStampSeconds::kNanosecondsOver1e9 : eval::EvoStampSeconds::kDecimal;
+}
+
+}  // namespace
+
+eval::EvaluationOptions OptionsForEstimate(eval::EvaluationOptions options, const EvalInputs& inputs, size_t k) {
+  options.association.ref_seconds = EvoSecondsOf(inputs.reference_format);
+  options.association.est_seconds = EvoSecondsOf(inputs.estimate_formats[k]);
+  return options;
 }
 
 namespace {
@@ -146,7 +195,9 @@ void PrintResult(const Evaluated& e, Eigen::Index ref_poses) {
       fmt::print("\n");
     }
   }
-  if (r.drift) {
+  if (r.drift && r.drift->segments == 0) {
+    fmt::print("\nKITTI drift over 100..800 m of reference path: none (path shorter than 100 m)\n");
+  } else if (r.drift) {
     fmt::print("\nKITTI drift over 100..800 m of reference path ({} segments): translation {:.4f} %, rotation "
                "{:.6f} deg/m\n",
                r.drift->segments, r.drift->translation_percent, r.drift->rotation_deg_per_m);
@@ -183,14 +234,23 @@ void Run(CLI::App* command, eval::MetricKind metric, const EvalFlags& flags) {
     e.reference_poses = ref.size();
     e.estimate_path = inputs.estimate_names[k];
     e.estimate_poses = ests[k].size();
-    e.options = options;
-    e.result = eval::Evaluate(ref.View(), ests[k].View(), options);
+    e.options = OptionsForEstimate(options, inputs, k);
+    e.result = eval::Evaluate(ref.View(), ests[k].View(), e.options);
     all.push_back(std::move(e));
   }
   std::string json_text, errors_text;
   if (!flags.json_path.empty()) json_text = eval::EvaluationJson(all);
   if (!flags.errors_path.empty()) errors_text = eval::EvaluationErrorsCsv(all);
 
+  // Warnings once each (several estimates against one reference repeat the reference's).
+  std::vector<std::string> warned;
+  for (const Evaluated& e : all) {
+    for (const std::string& w : e.result.warnings) {
+      if (std::find(warned.begin(), warned.end(), w) != warned.end()) continue;
+      warned.push_back(w);
+      fmt::print(stderr, "{}: warning: {}\n", flags.reference, Spell(w));
+    }
+  }
   for (const Evaluated& e : all) PrintResult(e, ref.size());
   if (all.size() > 1) PrintComparison(all);
   std::vector<OutputFile> files;
@@ -202,7 +262,7 @@ void Run(CLI::App* command, eval::MetricKind metric, const EvalFlags& flags) {
 }  // namespace
 
 void AddRelationFlag(CLI::App* command, EvalFlags* flags) {
-  command->add_option("-r," + Flag("EvaluationOptions::relation"), flags->relation, "Pose relation (evo's -r names)")
+  command->add_option(Names("EvaluationOptions::relation", "", "-r"), flags->relation, "Pose relation (evo's -r names)")
       ->check(CLI::IsMember({"trans_part", "rot_part", "full", "angle_deg", "angle_rad", "point_distance"}))
       ->capture_default_str();
 }
@@ -213,13 +273,30 @@ void AddEvalInputFlags(CLI::App* command, EvalFlags* flags) {
   AddInputFlags(command, &flags->both);
   AddInputFlags(command, &flags->ref, "ref-");
   AddInputFlags(command, &flags->est, "est-");
-  command->add_option(Flag("AlignmentOptions::method"), flags->align, "Alignment of each estimate onto the reference")
-      ->check(CLI::IsMember({"none", "origin", "se3", "sim3", "scale", "posyaw", "full"}))
+  // --align METHOD; a bare --align (evo's flag) means se3 like evo's -a.
+  command
+      ->add_option_function<std::string>(
+          Flag("AlignmentOptions::method"),
+          [flags](const std::string& method) {
+            if (method.empty()) {
+              flags->evo_align = true;
+            } else {
+              flags->align = method;
+              flags->align_given = true;
+            }
+          },
+          fmt::format("Alignment of each estimate onto the reference (default: {}; alone: se3, as evo's --align)",
+                      flags->align))
+      ->expected(0, 1)
+      ->check(CLI::IsMember({"", "none", "origin", "se3", "sim3", "scale", "posyaw", "full"}));
+  command->add_flag("-a", flags->evo_align, "evo's -a: --align se3 (with -s: sim3)");
+  command->add_flag("-s,--correct_scale", flags->evo_scale, "evo's -s: --align scale (with -a: sim3)");
+  command->add_flag("--align_origin", flags->evo_align_origin, "evo's --align_origin: --align origin");
+  command->add_flag("-v,--verbose", flags->verbose, "Accepted for evo's -v; cheval always prints these lines");
+  command->add_option(Names("AlignmentOptions::n_align"), flags->n_align, "Solve the alignment from the first N pairs only (default: all)");
+  command->add_option(Names("AssociationOptions::max_diff_ns"), flags->t_max_diff, "Largest stamp difference of an associated pair, seconds")
       ->capture_default_str();
-  command->add_option(Flag("AlignmentOptions::n_align"), flags->n_align, "Solve the alignment from the first N pairs only (default: all)");
-  command->add_option(Flag("AssociationOptions::max_diff_ns"), flags->t_max_diff, "Largest stamp difference of an associated pair, seconds")
-      ->capture_default_str();
-  command->add_option(Flag("AssociationOptions::offset_ns"), flags->t_offset, "Added to the estimate stamps: est + offset = ref, seconds")
+  command->add_option(Names("AssociationOptions::offset_ns"), flags->t_offset, "Added to the estimate stamps: est + offset = ref, seconds")
       ->capture_default_str();
   command->add_option(Flag("EvaluationOptions::continuous_reference"), flags->association,
                       "nearest: each estimate pose with the nearest reference pose (evo); continuous: the reference's "
