@@ -10,6 +10,7 @@
 
 #include "cheval/common/error.h"
 #include "cheval/common/options.h"
+#include "cheval/eval/extrinsic.h"
 #include "progress.h"
 #include "cheval/traj/stamp.h"
 
@@ -114,10 +115,25 @@ eval::EvaluationOptions ToEvaluationOptions(eval::MetricKind metric, const EvalF
 }
 
 std::vector<std::string> EvalInputPaths(const EvalFlags& flags) {
-  std::vector<std::string> paths{flags.reference, flags.both.kitti_times, flags.ref.kitti_times, flags.est.kitti_times};
+  std::vector<std::string> paths{flags.reference,       flags.both.kitti_times,     flags.ref.kitti_times,
+                                 flags.est.kitti_times,   flags.transform_left,       flags.transform_right,
+                                 flags.ref_transform_left, flags.ref_transform_right};
   paths.insert(paths.end(), flags.estimates.begin(), flags.estimates.end());
   return paths;
 }
+
+namespace {
+
+// `t` transformed by the extrinsic files given (either may be empty), before association.
+void ApplyExtrinsics(const std::string& left_path, const std::string& right_path, traj::Trajectory* t) {
+  if (left_path.empty() && right_path.empty()) return;
+  std::optional<eval::Extrinsic> left, right;
+  if (!left_path.empty()) left = eval::ReadExtrinsic(left_path);
+  if (!right_path.empty()) right = eval::ReadExtrinsic(right_path);
+  *t = eval::TransformTrajectory(t->View(), left ? &*left : nullptr, right ? &*right : nullptr);
+}
+
+}  // namespace
 
 EvalInputs ReadEvalInputs(CLI::App* command, const EvalFlags& flags) {
   const traj::ReadOptions ref_options = SideOptions(command, flags, "ref-", flags.ref);
@@ -137,6 +153,10 @@ EvalInputs ReadEvalInputs(CLI::App* command, const EvalFlags& flags) {
   inputs.reference = ref_future.get();
   for (const auto& source : sources) inputs.estimate_names.push_back(source.name);
   for (auto& f : est_futures) inputs.estimates.push_back(f.get());
+  ApplyExtrinsics(flags.ref_transform_left, flags.ref_transform_right, &inputs.reference);
+  for (traj::Trajectory& estimate : inputs.estimates) {
+    ApplyExtrinsics(flags.transform_left, flags.transform_right, &estimate);
+  }
   return inputs;
 }
 
@@ -292,6 +312,14 @@ void AddEvalInputFlags(CLI::App* command, EvalFlags* flags) {
   command->add_flag("-a", flags->evo_align, "evo's -a: --align se3 (with -s: sim3)");
   command->add_flag("-s,--correct_scale", flags->evo_scale, "evo's -s: --align scale (with -a: sim3)");
   command->add_flag("--align_origin", flags->evo_align_origin, "evo's --align_origin: --align origin");
+  command->add_option(FlagNames("--transform-left"), flags->transform_left,
+                      "Extrinsic applied to each estimate from the left (world frame), T*P: .json x y z qx qy qz qw "
+                      "[scale], .npy or text 4x4 matrix");
+  command->add_option(FlagNames("--transform-right"), flags->transform_right,
+                      "Extrinsic applied to each estimate from the right (body frame), P*T, e.g. estimator body to "
+                      "the reference's IMU");
+  command->add_option("--ref-transform-left", flags->ref_transform_left, "Like --transform-left, for the reference");
+  command->add_option("--ref-transform-right", flags->ref_transform_right, "Like --transform-right, for the reference");
   command->add_flag("-v,--verbose", flags->verbose, "Accepted for evo's -v; cheval always prints these lines");
   command->add_option(Names("AlignmentOptions::n_align"), flags->n_align, "Solve the alignment from the first N pairs only (default: all)");
   command->add_option(Names("AssociationOptions::max_diff_ns"), flags->t_max_diff, "Largest stamp difference of an associated pair, seconds")

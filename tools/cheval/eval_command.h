@@ -41,6 +41,8 @@ struct EvalFlags {
   bool evo_align_origin = false;  // --align_origin
   bool align_given = false;       // --align METHOD given
   bool verbose = false;           // -v: accepted, cheval always prints evo's verbose lines
+  // Extrinsic files (eval/extrinsic.h) applied to the estimates / the reference after reading.
+  std::string transform_left, transform_right, ref_transform_left, ref_transform_right;
 };
 
 /// The method of `flags`: --align, or evo's -a / -s / --align_origin (-a -s = sim3, -a = se3, -s =

@@ -99,6 +99,8 @@ constexpr std::array kEvo = std::to_array<EvoSpelling>({
     {"-d", "--delta", true},
     {"--delta_unit", "--delta-unit", true},
     {"--all_pairs", "--all-pairs", true},
+    {"--transform_left", "--transform-left", true},
+    {"--transform_right", "--transform-right", true},
     {"-v", "accepted: cheval always prints what evo prints with -v", false},
     {"--verbose", "accepted: cheval always prints what evo prints with -v", false},
     {"--full_check", "--full-check", true},
@@ -135,11 +137,14 @@ size_t EditDistance(std::string_view a, std::string_view b) {
 std::span<const EvoSpelling> EvoSpellings() { return kEvo; }
 
 std::string Names(std::string_view field, std::string_view prefix, std::string_view short_name) {
-  const std::string flag = Flag(field, prefix);
+  return FlagNames(Flag(field, prefix), prefix.empty(), short_name);
+}
+
+std::string FlagNames(const std::string& flag, bool with_evo, std::string_view short_name) {
   std::string names(short_name);
   if (!names.empty()) names += ',';
   names += flag;
-  if (!prefix.empty()) return names;  // evo has no per-side flags
+  if (!with_evo) return names;
   for (const EvoSpelling& e : kEvo) {
     if (e.alias && e.cheval == flag && e.evo != short_name) names.append(",").append(e.evo);
   }

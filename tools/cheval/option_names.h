@@ -42,6 +42,9 @@ std::span<const EvoSpelling> EvoSpellings();
 /// EvoSpellings, e.g. "--t-max-diff,--t_max_diff"; `short_name` ("-r") goes first when given.
 std::string Names(std::string_view field, std::string_view prefix = "", std::string_view short_name = "");
 
+/// The CLI11 names of `flag` (a flag without a library field) and, when `with_evo`, its evo aliases.
+std::string FlagNames(const std::string& flag, bool with_evo = true, std::string_view short_name = "");
+
 /// The message for flags a command does not take: for each, the cheval spelling when it is one of
 /// evo's (EvoSpellings), else the closest flag of `command` ("did you mean"), and a pointer to
 /// `cheval COMMAND --help`. `command` empty for the top level.
