@@ -375,6 +375,7 @@ Json ReportJson(const EvaluationReport& report) {
   j["command"] = std::string(ToString(r.metric));
   j["reference"] = {{"path", report.reference_path}, {"poses", report.reference_poses}};
   j["estimate"] = {{"path", report.estimate_path}, {"poses", report.estimate_poses}};
+  if (!report.estimate_label.empty()) j["estimate"]["label"] = report.estimate_label;
   j["association"] = {{"pairs", r.association.size()},
                       {"max_diff", options.association.max_diff_s()},
                       {"offset", options.association.offset_s()}};

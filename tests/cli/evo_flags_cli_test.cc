@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "../support/test_data.h"
 #include "cli_runner.h"
@@ -94,6 +95,38 @@ TEST_F(EvoFlagsCliTest, ContradictionsAndUnknownFlagsSayTheChevalSpelling) {
       EXPECT_NE(run.err.find(text), std::string::npos) << c.args << ": expected " << text << " in\n" << run.err;
     }
   }
+}
+
+}  // namespace
+}  // namespace cheval
+
+namespace cheval {
+namespace {
+
+class LabelCliTest : public testing::CliTest {};
+
+// --label names each estimate in order in the tables and the JSON; the default is the file name.
+TEST_F(LabelCliTest, LabelsInOrderElseTheFileName) {
+  CHEVAL_REQUIRE_SHARED_DATA();
+  const std::string evo = testing::SharedDataDir() + "/evo/";
+  const std::string files = evo + "fr2_desk_groundtruth.txt " + evo + "fr2_desk_ORB.txt " + evo + "fr2_desk_ORB_kf_mono.txt -as";
+  const testing::RunResult run =
+      Cheval(fmt::format("ape {} --label ORB --label 'ORB mono' --json {}", files, Path("l.json")));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("\nORB           0.006"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("\nORB mono      0.007"), std::string::npos) << run.out;
+  const nlohmann::json j = nlohmann::json::parse(testing::Slurp(Path("l.json")));
+  EXPECT_EQ(j[0]["estimate"]["label"], "ORB");
+  EXPECT_EQ(j[1]["estimate"]["label"], "ORB mono");
+  EXPECT_EQ(j[1]["estimate"]["path"], evo + "fr2_desk_ORB_kf_mono.txt");
+  const testing::RunResult plain = Cheval(fmt::format("ape {} --json {}", files, Path("p.json")));
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_NE(plain.out.find("\nfr2_desk_ORB_kf_mono.txt  "), std::string::npos) << plain.out;
+  EXPECT_EQ(plain.out.find(evo), std::string::npos) << "no folder in the tables:\n" << plain.out;
+  EXPECT_EQ(nlohmann::json::parse(testing::Slurp(Path("p.json")))[0]["estimate"]["label"], "fr2_desk_ORB.txt");
+  const testing::RunResult wrong = Cheval(fmt::format("ape {} --label only-one", files));
+  EXPECT_EQ(wrong.exit_code, 1);
+  EXPECT_NE(wrong.err.find("--label given 1 times for 2 estimates"), std::string::npos) << wrong.err;
 }
 
 }  // namespace

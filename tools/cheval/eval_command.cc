@@ -133,6 +133,23 @@ void ApplyExtrinsics(const std::string& left_path, const std::string& right_path
   *t = eval::TransformTrajectory(t->View(), left ? &*left : nullptr, right ? &*right : nullptr);
 }
 
+// --label values in order, else each source's name without its folders.
+std::vector<std::string> EstimateLabels(const EvalFlags& flags, const std::vector<EstimateSource>& sources) {
+  if (!flags.labels.empty()) {
+    if (flags.labels.size() != sources.size()) {
+      throw UsageError(fmt::format("--label given {} times for {} estimates: give one per estimate, in order",
+                                   flags.labels.size(), sources.size()));
+    }
+    return flags.labels;
+  }
+  std::vector<std::string> labels;
+  for (const EstimateSource& source : sources) {
+    const std::string file = std::filesystem::path(source.path).filename().string();
+    labels.push_back(file + source.name.substr(source.path.size()));  // keeps ":TOPIC"
+  }
+  return labels;
+}
+
 }  // namespace
 
 EvalInputs ReadEvalInputs(CLI::App* command, const EvalFlags& flags) {
@@ -152,6 +169,7 @@ EvalInputs ReadEvalInputs(CLI::App* command, const EvalFlags& flags) {
   }
   inputs.reference = ref_future.get();
   for (const auto& source : sources) inputs.estimate_names.push_back(source.name);
+  inputs.estimate_labels = EstimateLabels(flags, sources);
   for (auto& f : est_futures) inputs.estimates.push_back(f.get());
   ApplyExtrinsics(flags.ref_transform_left, flags.ref_transform_right, &inputs.reference);
   for (traj::Trajectory& estimate : inputs.estimates) {
@@ -188,13 +206,13 @@ void PrintResult(const Evaluated& e, Eigen::Index ref_poses) {
   const eval::EvaluationResult& r = e.result;
   const Eigen::Index shorter = std::min(ref_poses, e.estimate_poses);
   if (r.association.by_index) {
-    fmt::print("{}: {} pairs (no stamps: pose i with pose i)\n", e.estimate_path, r.association.size());
+    fmt::print("{}: {} pairs (no stamps: pose i with pose i)\n", e.estimate_label, r.association.size());
   } else if (r.continuous_reference) {
     fmt::print("{}: {} of {} estimate stamps inside the reference's Chebyshev curve (continuous reference)\n",
-               e.estimate_path, r.association.size(), e.estimate_poses);
+               e.estimate_label, r.association.size(), e.estimate_poses);
   } else {
     fmt::print("{}: found {} of max. {} possible matching timestamps (t_max_diff {} s, t_offset {} s)\n",
-               e.estimate_path, r.association.size(), shorter, e.options.association.max_diff_s(),
+               e.estimate_label, r.association.size(), shorter, e.options.association.max_diff_s(),
                e.options.association.offset_s());
   }
   fmt::print("{}\n\n", r.title);
@@ -228,13 +246,13 @@ void PrintResult(const Evaluated& e, Eigen::Index ref_poses) {
 // Several estimates: one table, the paper's Table II form.
 void PrintComparison(const std::vector<Evaluated>& all) {
   size_t width = 8;
-  for (const Evaluated& e : all) width = std::max(width, e.estimate_path.size());
+  for (const Evaluated& e : all) width = std::max(width, e.estimate_label.size());
   const eval::EvaluationResult& first = all.front().result;
   fmt::print("{} {}, {} estimates\n", first.title.substr(0, first.title.find('\n')),
              first.title.substr(first.title.rfind('\n') + 1), all.size());
   fmt::print("{:<{}}  {:>12}  {:>12}  {:>12}  {:>8}\n", "estimate", width, "rmse", "std", "median", "pairs");
   for (const Evaluated& e : all) {
-    fmt::print("{:<{}}  {:>12.6f}  {:>12.6f}  {:>12.6f}  {:>8}\n", e.estimate_path, width, e.result.stats.rmse,
+    fmt::print("{:<{}}  {:>12.6f}  {:>12.6f}  {:>12.6f}  {:>8}\n", e.estimate_label, width, e.result.stats.rmse,
                e.result.stats.std, e.result.stats.median, e.result.stats.n);
   }
 }
@@ -253,6 +271,7 @@ void Run(CLI::App* command, eval::MetricKind metric, const EvalFlags& flags) {
     e.reference_path = flags.reference;
     e.reference_poses = ref.size();
     e.estimate_path = inputs.estimate_names[k];
+    e.estimate_label = inputs.estimate_labels[k];
     e.estimate_poses = ests[k].size();
     e.options = OptionsForEstimate(options, inputs, k);
     e.result = eval::Evaluate(ref.View(), ests[k].View(), e.options);
@@ -312,6 +331,10 @@ void AddEvalInputFlags(CLI::App* command, EvalFlags* flags) {
   command->add_flag("-a", flags->evo_align, "evo's -a: --align se3 (with -s: sim3)");
   command->add_flag("-s,--correct_scale", flags->evo_scale, "evo's -s: --align scale (with -a: sim3)");
   command->add_flag("--align_origin", flags->evo_align_origin, "evo's --align_origin: --align origin");
+  command->add_option("--label", flags->labels,
+                      "Name of each estimate in the tables and the JSON, one per estimate in order (default: the file "
+                      "name)")
+      ->allow_extra_args(false);
   command->add_option(FlagNames("--transform-left"), flags->transform_left,
                       "Extrinsic applied to each estimate from the left (world frame), T*P: .json x y z qx qy qz qw "
                       "[scale], .npy or text 4x4 matrix");

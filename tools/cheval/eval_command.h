@@ -43,6 +43,8 @@ struct EvalFlags {
   bool verbose = false;           // -v: accepted, cheval always prints evo's verbose lines
   // Extrinsic files (eval/extrinsic.h) applied to the estimates / the reference after reading.
   std::string transform_left, transform_right, ref_transform_left, ref_transform_right;
+  // --label NAME per estimate, in order (EvalInputs::estimate_labels).
+  std::vector<std::string> labels;
 };
 
 /// The method of `flags`: --align, or evo's -a / -s / --align_origin (-a -s = sim3, -a = se3, -s =
@@ -71,6 +73,9 @@ struct EvalInputs {
   traj::Trajectory reference;
   std::vector<traj::Trajectory> estimates;
   std::vector<std::string> estimate_names;  ///< the paths (PATH:TOPIC for several --est-topic)
+  /// The names to show for the estimates: the --label values in order, else each file's name
+  /// without its folders (NAME:TOPIC for several --est-topic). For tables, JSON and the report.
+  std::vector<std::string> estimate_labels;
   traj::Format reference_format = traj::Format::kAuto;  ///< the formats read (never kAuto once read)
   std::vector<traj::Format> estimate_formats;
 };

@@ -118,6 +118,9 @@ struct EvaluationReport {
   std::string reference_path;
   Eigen::Index reference_poses = 0;
   std::string estimate_path;
+  /// The estimate's name in tables (`--label`, default the file name); in the JSON as
+  /// `estimate.label` when not empty.
+  std::string estimate_label;
   Eigen::Index estimate_poses = 0;
   EvaluationOptions options;
   EvaluationResult result;
