@@ -122,8 +122,9 @@ TEST_F(LabelCliTest, LabelsInOrderElseTheFileName) {
   const testing::RunResult plain = Cheval(fmt::format("ape {} --json {}", files, Path("p.json")));
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
   EXPECT_NE(plain.out.find("\nfr2_desk_ORB_kf_mono.txt  "), std::string::npos) << plain.out;
-  EXPECT_EQ(plain.out.find(evo), std::string::npos) << "no folder in the tables:\n" << plain.out;
-  EXPECT_EQ(nlohmann::json::parse(testing::Slurp(Path("p.json")))[0]["estimate"]["label"], "fr2_desk_ORB.txt");
+  const std::string table = plain.out.substr(plain.out.find("2 estimates"));
+  EXPECT_EQ(table.find(evo), std::string::npos) << "no folder in the table:\n" << table;
+  EXPECT_FALSE(nlohmann::json::parse(testing::Slurp(Path("p.json")))[0]["estimate"].contains("label"));
   const testing::RunResult wrong = Cheval(fmt::format("ape {} --label only-one", files));
   EXPECT_EQ(wrong.exit_code, 1);
   EXPECT_NE(wrong.err.find("--label given 1 times for 2 estimates"), std::string::npos) << wrong.err;

@@ -11,6 +11,7 @@
 #include "cheval/common/error.h"
 #include "cheval/common/options.h"
 #include "cheval/eval/extrinsic.h"
+#include "cheval/eval/res_file.h"
 #include "progress.h"
 #include "cheval/traj/stamp.h"
 
@@ -203,16 +204,17 @@ std::vector<std::pair<std::string, double>> SortedStats(const eval::ErrorStatist
 }
 
 void PrintResult(const Evaluated& e, Eigen::Index ref_poses) {
+  const std::string& name = e.estimate_label.empty() ? e.estimate_path : e.estimate_label;
   const eval::EvaluationResult& r = e.result;
   const Eigen::Index shorter = std::min(ref_poses, e.estimate_poses);
   if (r.association.by_index) {
-    fmt::print("{}: {} pairs (no stamps: pose i with pose i)\n", e.estimate_label, r.association.size());
+    fmt::print("{}: {} pairs (no stamps: pose i with pose i)\n", name, r.association.size());
   } else if (r.continuous_reference) {
     fmt::print("{}: {} of {} estimate stamps inside the reference's Chebyshev curve (continuous reference)\n",
-               e.estimate_label, r.association.size(), e.estimate_poses);
+               name, r.association.size(), e.estimate_poses);
   } else {
     fmt::print("{}: found {} of max. {} possible matching timestamps (t_max_diff {} s, t_offset {} s)\n",
-               e.estimate_label, r.association.size(), shorter, e.options.association.max_diff_s(),
+               name, r.association.size(), shorter, e.options.association.max_diff_s(),
                e.options.association.offset_s());
   }
   fmt::print("{}\n\n", r.title);
@@ -244,22 +246,25 @@ void PrintResult(const Evaluated& e, Eigen::Index ref_poses) {
 }
 
 // Several estimates: one table, the paper's Table II form.
-void PrintComparison(const std::vector<Evaluated>& all) {
+void PrintComparison(const std::vector<Evaluated>& all, const std::vector<std::string>& labels) {
   size_t width = 8;
-  for (const Evaluated& e : all) width = std::max(width, e.estimate_label.size());
+  for (const std::string& label : labels) width = std::max(width, label.size());
   const eval::EvaluationResult& first = all.front().result;
   fmt::print("{} {}, {} estimates\n", first.title.substr(0, first.title.find('\n')),
              first.title.substr(first.title.rfind('\n') + 1), all.size());
   fmt::print("{:<{}}  {:>12}  {:>12}  {:>12}  {:>8}\n", "estimate", width, "rmse", "std", "median", "pairs");
-  for (const Evaluated& e : all) {
-    fmt::print("{:<{}}  {:>12.6f}  {:>12.6f}  {:>12.6f}  {:>8}\n", e.estimate_label, width, e.result.stats.rmse,
+  for (size_t k = 0; k < all.size(); ++k) {
+    const Evaluated& e = all[k];
+    fmt::print("{:<{}}  {:>12.6f}  {:>12.6f}  {:>12.6f}  {:>8}\n", labels[k], width, e.result.stats.rmse,
                e.result.stats.std, e.result.stats.median, e.result.stats.n);
   }
 }
 
 void Run(CLI::App* command, eval::MetricKind metric, const EvalFlags& flags) {
   const eval::EvaluationOptions options = ToEvaluationOptions(metric, flags);
-  RefuseSharedPaths(EvalInputPaths(flags), {{"--json", flags.json_path}, {"--errors", flags.errors_path}});
+  RefuseSharedPaths(EvalInputPaths(flags), {{"--json", flags.json_path},
+                                            {"--errors", flags.errors_path},
+                                            {"--save-results", flags.save_results}});
   const EvalInputs inputs = ReadEvalInputs(command, flags);
   const traj::Trajectory& ref = inputs.reference;
   const std::vector<traj::Trajectory>& ests = inputs.estimates;
@@ -271,13 +276,22 @@ void Run(CLI::App* command, eval::MetricKind metric, const EvalFlags& flags) {
     e.reference_path = flags.reference;
     e.reference_poses = ref.size();
     e.estimate_path = inputs.estimate_names[k];
-    e.estimate_label = inputs.estimate_labels[k];
+    // The JSON names a label only when --label gave one (its default, the file name, is in the path).
+    if (!flags.labels.empty()) e.estimate_label = inputs.estimate_labels[k];
     e.estimate_poses = ests[k].size();
     e.options = OptionsForEstimate(options, inputs, k);
     e.result = eval::Evaluate(ref.View(), ests[k].View(), e.options);
     all.push_back(std::move(e));
   }
-  std::string json_text, errors_text;
+  std::string json_text, errors_text, zip_bytes;
+  if (!flags.save_results.empty()) {
+    if (all.size() != 1) {
+      throw UsageError(fmt::format("--save-results writes evo's result file of one estimate, and {} were given: run "
+                                   "once per estimate",
+                                   all.size()));
+    }
+    zip_bytes = eval::EvoResultZip(all.front());
+  }
   if (!flags.json_path.empty()) json_text = eval::EvaluationJson(all);
   if (!flags.errors_path.empty()) errors_text = eval::EvaluationErrorsCsv(all);
 
@@ -291,10 +305,11 @@ void Run(CLI::App* command, eval::MetricKind metric, const EvalFlags& flags) {
     }
   }
   for (const Evaluated& e : all) PrintResult(e, ref.size());
-  if (all.size() > 1) PrintComparison(all);
+  if (all.size() > 1) PrintComparison(all, inputs.estimate_labels);
   std::vector<OutputFile> files;
   if (!flags.json_path.empty()) files.push_back({flags.json_path, json_text});
   if (!flags.errors_path.empty()) files.push_back({flags.errors_path, errors_text});
+  if (!flags.save_results.empty()) files.push_back({flags.save_results, zip_bytes});
   WriteOutputs(files);
 }
 
@@ -375,6 +390,8 @@ void RegisterEvalCommand(CLI::App& app, Action* action, eval::MetricKind metric,
   AddEvalInputFlags(command, flags.get());
   command->add_option("--json", flags->json_path, "Write the result as JSON (an array for several estimates)");
   command->add_option("--errors", flags->errors_path, "Write the per-pair errors as CSV");
+  command->add_option(FlagNames("--save-results"), flags->save_results,
+                      "Write evo's result zip (what evo_res and file_interface.load_res_file read); one estimate");
   add_flags(command, flags.get());
   command->callback([command, metric, flags, action] {
     *action = [command, metric, flags] { Run(command, metric, *flags); };

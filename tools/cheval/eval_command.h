@@ -45,6 +45,7 @@ struct EvalFlags {
   std::string transform_left, transform_right, ref_transform_left, ref_transform_right;
   // --label NAME per estimate, in order (EvalInputs::estimate_labels).
   std::vector<std::string> labels;
+  std::string save_results;  // --save-results: evo's result zip (eval/res_file.h), one estimate
 };
 
 /// The method of `flags`: --align, or evo's -a / -s / --align_origin (-a -s = sim3, -a = se3, -s =

@@ -99,6 +99,7 @@ constexpr std::array kEvo = std::to_array<EvoSpelling>({
     {"-d", "--delta", true},
     {"--delta_unit", "--delta-unit", true},
     {"--all_pairs", "--all-pairs", true},
+    {"--save_results", "--save-results", true},
     {"--transform_left", "--transform-left", true},
     {"--transform_right", "--transform-right", true},
     {"-v", "accepted: cheval always prints what evo prints with -v", false},
