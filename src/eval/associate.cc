@@ -1,7 +1,11 @@
 #include "cheval/eval/associate.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
 #include <numeric>
 
 #include <fmt/format.h>
@@ -40,12 +44,79 @@ struct SortedStamps {
   Eigen::Index FileIndex(Eigen::Index sorted) const { return order.empty() ? sorted : order[static_cast<size_t>(sorted)]; }
 };
 
+// evo's decision in float64 seconds (sync.matching_time_indices): for a stamp s1 of the shorter list,
+// the index of the smallest |(s2 + offset_2) - s1| over the longer list, the first in file order on
+// equal values (np.argmin), kept when that value is <= max_diff. The exact nanosecond search finds
+// the nearest stamp; evo's argmin is among the stamps within float rounding of it (margin_ns), which
+// are compared here with evo's arithmetic.
+struct EvoChoice {
+  std::vector<double> shorter_s, longer_s;  // evo's seconds, in file order
+  double offset_2 = 0.0, max_diff = 0.0;
+  Wide margin_ns = 0;
+
+  EvoChoice(std::span<const int64_t> shorter, std::span<const int64_t> longer, const SortedStamps& sorted,
+            bool est_longer, const AssociationOptions& options)
+      : offset_2((est_longer ? 1.0 : -1.0) * options.offset_s()), max_diff(options.max_diff_s()) {
+    const EvoStampSeconds short_kind = est_longer ? options.ref_seconds : options.est_seconds;
+    const EvoStampSeconds long_kind = est_longer ? options.est_seconds : options.ref_seconds;
+    shorter_s.reserve(shorter.size());
+    longer_s.reserve(longer.size());
+    double largest = std::abs(offset_2);
+    for (int64_t ns : shorter) shorter_s.push_back(EvoSeconds(ns, short_kind));
+    for (int64_t ns : longer) longer_s.push_back(EvoSeconds(ns, long_kind));
+    for (double v : shorter_s) largest = std::max(largest, std::abs(v));
+    largest = std::max({largest, std::abs(EvoSeconds(sorted.stamps.front(), long_kind)),
+                        std::abs(EvoSeconds(sorted.stamps.back(), long_kind))});
+    // Each of the <= 6 roundings (two per conversion, the offset, the difference) is at most half an
+    // ulp of the largest magnitude; 16 ulps in nanoseconds bound them with room.
+    margin_ns = static_cast<Wide>(std::ceil(16.0 * largest * std::numeric_limits<double>::epsilon() * 1e9)) + 16;
+  }
+
+  Eigen::Index Choose(const SortedStamps& sorted, Eigen::Index lo, Wide q, Wide nearest_diff, Eigen::Index k) const {
+    const Wide reach = nearest_diff + margin_ns;
+    const double s1 = shorter_s[static_cast<size_t>(k)];
+    Eigen::Index best = -1;
+    double best_value = std::numeric_limits<double>::infinity();
+    // Equal stamps have equal seconds: the first of a run in file order (the run's start) stands for it.
+    auto consider = [&](Eigen::Index position) {
+      const Eigen::Index file = sorted.FileIndex(position);
+      const double value = std::abs((longer_s[static_cast<size_t>(file)] + offset_2) - s1);
+      if (value < best_value || (value == best_value && file < best)) best = file, best_value = value;
+    };
+    const Eigen::Index m = static_cast<Eigen::Index>(sorted.stamps.size());
+    for (Eigen::Index j = lo - 1; j >= 0 && q - Wide{sorted.stamps[static_cast<size_t>(j)]} <= reach;) {
+      j = sorted.run_start[static_cast<size_t>(j)];
+      consider(j);
+      --j;
+    }
+    for (Eigen::Index j = lo; j < m && Wide{sorted.stamps[static_cast<size_t>(j)]} - q <= reach;) {
+      consider(j);  // lo and every position reached below start a run
+      const int64_t stamp = sorted.stamps[static_cast<size_t>(j)];
+      j = std::upper_bound(sorted.stamps.begin() + j, sorted.stamps.end(), stamp) - sorted.stamps.begin();
+    }
+    return best_value <= max_diff ? best : -1;
+  }
+};
+
 std::string Range(std::span<const int64_t> stamps) {
   const auto [lo, hi] = std::minmax_element(stamps.begin(), stamps.end());
   return fmt::format("{} .. {} s", traj::FormatSeconds(*lo), traj::FormatSeconds(*hi));
 }
 
 }  // namespace
+
+double EvoSeconds(int64_t ns, EvoStampSeconds kind) {
+  if (kind == EvoStampSeconds::kNanosecondsOver1e9) return static_cast<double>(ns) / 1e9;
+  // The decimal "[-]S.NNNNNNNNN", parsed to the nearest double as Python's float() does.
+  const uint64_t magnitude = ns < 0 ? 0 - static_cast<uint64_t>(ns) : static_cast<uint64_t>(ns);
+  char text[40];
+  const int length = std::snprintf(text, sizeof text, "%s%llu.%09llu", ns < 0 ? "-" : "",
+                                   static_cast<unsigned long long>(magnitude / 1000000000ULL),
+                                   static_cast<unsigned long long>(magnitude % 1000000000ULL));
+  double value = 0.0;
+  std::from_chars(text, text + length, value);
+  return value;
+}
 
 int64_t SecondsToNanoseconds(double seconds, const std::string& what) {
   const double ns = std::round(seconds * 1e9);
@@ -89,6 +160,8 @@ Association AssociateStamps(std::span<const int64_t> ref_stamps_ns, std::span<co
   const Wide walk_limit = Wide{64} * (Wide{sorted.stamps.back()} - Wide{sorted.stamps.front()} + 1) / m;
   result.ref.reserve(shorter.size());
   result.est.reserve(shorter.size());
+  std::optional<EvoChoice> evo;
+  if (options.evo_float_seconds) evo.emplace(shorter, longer, sorted, est_longer, options);
   Eigen::Index lo = 0;
   Wide previous_q = 0;
   for (Eigen::Index k = 0; k < static_cast<Eigen::Index>(shorter.size()); ++k) {
@@ -120,10 +193,15 @@ Association AssociateStamps(std::span<const int64_t> ref_stamps_ns, std::span<co
         best_diff = diff;
       }
     }
-    if (best_diff <= Wide{options.max_diff_ns}) {
-      (est_longer ? result.ref : result.est).push_back(k);
-      (est_longer ? result.est : result.ref).push_back(best);
+    if (options.evo_float_seconds) {
+      if (best_diff > Wide{options.max_diff_ns} + 2 * evo->margin_ns) continue;
+      best = evo->Choose(sorted, lo, q, best_diff, k);
+      if (best < 0) continue;
+    } else if (best_diff > Wide{options.max_diff_ns}) {
+      continue;
     }
+    (est_longer ? result.ref : result.est).push_back(k);
+    (est_longer ? result.est : result.ref).push_back(best);
   }
   return result;
 }

@@ -207,6 +207,23 @@ traj::Trajectory ContinuousReference(const traj::TrajectoryView& ref, const traj
   return out;
 }
 
+// True when `t` has orientations and every one is exactly the identity rotation.
+bool AllIdentityOrientations(const traj::TrajectoryView& t) {
+  if (!t.has_orientation() || t.empty()) return false;
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    if (t.Rotation(i) != Eigen::Matrix3d::Identity()) return false;
+  }
+  return true;
+}
+
+traj::TrajectoryView WithoutOrientation(const traj::TrajectoryView& t) {
+  traj::Channels channels = t.channels();
+  channels.orientation = traj::OrientationKind::kNone;
+  return traj::TrajectoryView(channels, t.stamps_ns(), t.positions().data(), nullptr,
+                              t.has_velocity() ? t.velocities().data() : nullptr,
+                              t.has_angular_velocity() ? t.angular_velocities().data() : nullptr);
+}
+
 void EvaluateAse(PairedStates& pairs, const EvaluationOptions& options, EvaluationResult* result) {
   const AseErrors ase = AseErrorsOf(pairs, !options.pose_only);
   result->errors = ase.total;
@@ -261,7 +278,14 @@ EvaluationResult Evaluate(const traj::TrajectoryView& ref, const traj::Trajector
   } else {
     result.association = Associate(ref, est, options.association);
   }
-  const traj::TrajectoryView reference = options.continuous_reference ? result.continuous_reference->View() : ref;
+  traj::TrajectoryView reference = options.continuous_reference ? result.continuous_reference->View() : ref;
+  if (options.metric == MetricKind::kAse && options.identity_reference_is_position_only &&
+      AllIdentityOrientations(reference)) {
+    reference = WithoutOrientation(reference);
+    result.warnings.push_back(
+        "the reference's orientations are all the identity: taken as position-only, the ASE's rotation part is "
+        "left out (to take them as real: EvaluationOptions::identity_reference_is_position_only)");
+  }
   PairedStates pairs(reference, est, result.association);
   if (options.metric == MetricKind::kAse) {
     result.velocity_source = "none";
@@ -335,6 +359,9 @@ std::string CsvField(std::string_view text) {
   return quoted + '"';
 }
 
+// A mean over `count` items: null when there are none.
+Json OrNull(Eigen::Index count, double mean) { return count > 0 ? Json(mean) : Json(nullptr); }
+
 Json StatisticsJson(const ErrorStatistics& s) {
   return Json{{"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median}, {"std", s.std},
               {"min", s.min},   {"max", s.max},   {"sse", s.sse},       {"n", s.n}};
@@ -348,6 +375,7 @@ Json ReportJson(const EvaluationReport& report) {
   j["command"] = std::string(ToString(r.metric));
   j["reference"] = {{"path", report.reference_path}, {"poses", report.reference_poses}};
   j["estimate"] = {{"path", report.estimate_path}, {"poses", report.estimate_poses}};
+  if (!report.estimate_label.empty()) j["estimate"]["label"] = report.estimate_label;
   j["association"] = {{"pairs", r.association.size()},
                       {"max_diff", options.association.max_diff_s()},
                       {"offset", options.association.offset_s()}};
@@ -378,11 +406,12 @@ Json ReportJson(const EvaluationReport& report) {
   if (r.drift) {
     Json lengths = Json::array();
     for (const auto& l : r.drift->lengths) {
-      lengths.push_back({{"length_m", l.length_m}, {"translation_percent", l.translation_percent},
-                         {"rotation_deg_per_m", l.rotation_deg_per_m}, {"segments", l.segments}});
+      // No segment of a length: no mean (null), not 0 %.
+      lengths.push_back({{"length_m", l.length_m}, {"translation_percent", OrNull(l.segments, l.translation_percent)},
+                         {"rotation_deg_per_m", OrNull(l.segments, l.rotation_deg_per_m)}, {"segments", l.segments}});
     }
-    j["drift"] = {{"translation_percent", r.drift->translation_percent},
-                  {"rotation_deg_per_m", r.drift->rotation_deg_per_m},
+    j["drift"] = {{"translation_percent", OrNull(r.drift->segments, r.drift->translation_percent)},
+                  {"rotation_deg_per_m", OrNull(r.drift->segments, r.drift->rotation_deg_per_m)},
                   {"segments", r.drift->segments},
                   {"lengths", lengths}};
   }

@@ -102,6 +102,7 @@ TEST(AssociateTest, MatchesBruteForceOnRandomLists) {
       std::sort(est.begin(), est.end());
     }
     AssociationOptions options;
+    options.evo_float_seconds = false;  // the exact rule; evo's float decisions: associate_ties_test.cc
     options.max_diff_ns = static_cast<int64_t>(rng() % 4) * 5 * kMs;  // 0, 5, 10, 15 ms: exact hits and ties
     options.offset_ns = (static_cast<int64_t>(rng() % 5) - 2) * 5 * kMs;
     const Association fast = AssociateStamps(ref, est, options);
@@ -126,6 +127,7 @@ TEST(AssociateTest, MatchesBruteForceOnLongClusteredLists) {
     std::sort(est.begin(), est.end());
     if (trial % 3 == 2) std::shuffle(est.begin(), est.end(), rng);
     AssociationOptions options;
+    options.evo_float_seconds = false;
     options.max_diff_ns = static_cast<int64_t>(trial) * 2 * kMs;
     const Association fast = AssociateStamps(ref, est, options);
     const Association slow = BruteForce(ref, est, options.max_diff_ns, 0);

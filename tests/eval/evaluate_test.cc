@@ -121,6 +121,32 @@ TEST(EvaluateTest, AseOfAVelocityOffsetIsItsNorm) {
   EXPECT_LT(pose.stats.max, 1e-12);
 }
 
+// A reference whose orientations are all the identity (a position-only source written with identity
+// quaternions) is position-only for the ASE, with one warning; identity_reference_is_position_only =
+// false keeps the rotation part, which is then the estimate's own rotation angle.
+TEST(EvaluateTest, AseTakesAnIdentityOrientationReferenceAsPositionOnly) {
+  std::vector<PoseSpec> identity = Helix(100);
+  for (PoseSpec& s : identity) s.q = Eigen::Quaterniond::Identity();
+  const traj::Trajectory ref = MakeTrajectory(identity, true);
+  const traj::Trajectory est = MakeTrajectory(Helix(100), true);  // rotating, same positions and velocities
+  EvaluationOptions options;
+  options.metric = MetricKind::kAse;
+  const EvaluationResult r = Evaluate(ref.View(), est.View(), options);
+  EXPECT_FALSE(r.ase->has_rotation);
+  EXPECT_EQ(r.relation, "position+velocity");
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("identity_reference_is_position_only"), std::string::npos);
+  EXPECT_LT(r.stats.max, 1e-12);  // positions and velocities agree
+  options.identity_reference_is_position_only = false;
+  const EvaluationResult kept = Evaluate(ref.View(), est.View(), options);
+  EXPECT_TRUE(kept.ase->has_rotation);
+  EXPECT_TRUE(kept.warnings.empty());
+  EXPECT_GT(kept.stats.max, 0.1);  // the helix turns: the identity "orientation" is wrong by that much
+  // A reference with real orientations gets no warning.
+  options.identity_reference_is_position_only = true;
+  EXPECT_TRUE(Evaluate(est.View(), est.View(), options).warnings.empty());
+}
+
 TEST(EvaluateTest, ValidateNamesTheFirstBadField) {
   EvaluationOptions options;
   EXPECT_NO_THROW(options.Validate());

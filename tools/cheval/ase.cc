@@ -12,6 +12,11 @@ void RegisterAse(CLI::App& app, Action* action) {
         AddStateVelocityFlags(command, flags);
         command->add_flag(Flag("EvaluationOptions::pose_only"), flags->options.pose_only,
                           "Pose-only ASE (rotation + position) for estimates without velocity");
+        command->add_flag_callback(
+            "--ref-has-orientation",
+            [flags] { flags->options.identity_reference_is_position_only = false; },
+            "Take a reference whose orientations are all the identity as real orientations (by default it is "
+            "position-only, as written for position-only sources, and the rotation part is left out)");
       });
 }
 

@@ -35,7 +35,25 @@ struct EvalFlags {
   std::string velocity_frame = options.estimate_velocity_body_frame ? "body" : "world";
   std::string json_path;
   std::string errors_path;
+  // evo's alignment flags (docs/cli.md, "evo's flags"), resolved into `align` by ToEvaluationOptions.
+  bool evo_align = false;         // -a (or --align without a method)
+  bool evo_scale = false;         // -s, --correct_scale
+  bool evo_align_origin = false;  // --align_origin
+  bool align_given = false;       // --align METHOD given
+  bool verbose = false;           // -v: accepted, cheval always prints evo's verbose lines
+  // Extrinsic files (eval/extrinsic.h) applied to the estimates / the reference after reading.
+  std::string transform_left, transform_right, ref_transform_left, ref_transform_right;
+  // --label NAME per estimate, in order (EvalInputs::estimate_labels).
+  std::vector<std::string> labels;
+  std::string save_results;  // --save-results: evo's result zip (eval/res_file.h), one estimate
 };
+
+/// The method of `flags`: --align, or evo's -a / -s / --align_origin (-a -s = sim3, -a = se3, -s =
+/// scale). Throws UsageError when they contradict each other.
+std::string ResolvedAlignment(const EvalFlags& flags);
+
+/// The "did you mean" message of main() for arguments the parsed command did not take.
+std::string UnknownFlags(const CLI::App& app, const std::vector<std::string>& arguments);
 
 /// Adds `-r,--relation` (APE and RPE).
 void AddRelationFlag(CLI::App* command, EvalFlags* flags);
@@ -56,7 +74,16 @@ struct EvalInputs {
   traj::Trajectory reference;
   std::vector<traj::Trajectory> estimates;
   std::vector<std::string> estimate_names;  ///< the paths (PATH:TOPIC for several --est-topic)
+  /// The names to show for the estimates: the --label values in order, else each file's name
+  /// without its folders (NAME:TOPIC for several --est-topic). For tables, JSON and the report.
+  std::vector<std::string> estimate_labels;
+  traj::Format reference_format = traj::Format::kAuto;  ///< the formats read (never kAuto once read)
+  std::vector<traj::Format> estimate_formats;
 };
+
+/// `options` for estimate `k` of `inputs`: the association decides ties on the float seconds evo
+/// would read from each file's format (eval::EvoStampSeconds).
+eval::EvaluationOptions OptionsForEstimate(eval::EvaluationOptions options, const EvalInputs& inputs, size_t k);
 
 /// Every file an evaluation reads: the reference, the estimates and the KITTI times files of both sides
 /// (empty when not given), for RefuseSharedPaths.

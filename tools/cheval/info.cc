@@ -18,6 +18,7 @@ struct InfoFlags {
   std::vector<std::string> paths;
   InputFlags input;
   std::string json_path;
+  bool full_check = false;  // evo_traj --full_check: accepted, every check always runs
 };
 
 void PrintSummary(const std::string& path, const std::string& format, const traj::TrajectorySummary& s) {
@@ -76,6 +77,8 @@ void RegisterInfo(CLI::App& app, Action* action) {
   command->add_option("files", flags->paths, "Trajectory files")->required();
   AddInputFlags(command, &flags->input);
   command->add_option("--json", flags->json_path, "Also write the summary as JSON (an array for several files)");
+  command->add_flag("--full-check,--full_check", flags->full_check,
+                    "Accepted for evo_traj's --full_check: info always runs every check");
   command->callback([flags, action] {
     *action = [flags] {
       std::vector<std::string> inputs = flags->paths;

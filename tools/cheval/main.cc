@@ -13,6 +13,7 @@
 
 #include "cheval/common/error.h"
 #include "common.h"
+#include "eval_command.h"
 #include "option_names.h"
 #include "progress.h"
 
@@ -59,6 +60,9 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
+  } catch (const CLI::ExtrasError& e) {
+    // evo's spellings and near misses: the cheval flag and `cheval COMMAND --help` (option_names.h).
+    return fail(ExitCode::kUsage, cheval::cli::UnknownFlags(app, app.remaining(true)));
   } catch (const CLI::ParseError& e) {
     return fail(ExitCode::kUsage, fmt::format("cheval: error: {}\nRun 'cheval --help' for usage.", e.what()));
   }

@@ -1,7 +1,11 @@
 #include "option_names.h"
 
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <stdexcept>
+
+#include <fmt/format.h>
 
 #include "cheval/common/option_names.h"
 
@@ -30,6 +34,7 @@ constexpr std::array kFlags = std::to_array<OptionName>({
     {"EvaluationOptions::reference_velocity", "--gt-velocity"},
     {"EvaluationOptions::estimate_velocity_body_frame", "--velocity-frame"},
     {"EvaluationOptions::pose_only", "--pose-only"},
+    {"EvaluationOptions::identity_reference_is_position_only", "--ref-has-orientation"},
     // eval::VelocityOptions and the curve fit (cheb::CurveOptions)
     {"VelocityOptions::method", "--method"},
     {"VelocityOptions::angular", "--angular"},
@@ -78,7 +83,101 @@ constexpr std::array kFlags = std::to_array<OptionName>({
     {"ThrustEstimateOptions::rotor_delay_s", "--rotor-delay"},
 });
 
+// evo's spellings (evo_ape / evo_rpe / evo_traj 1.36.5 argparse names), one table for the CLI's
+// names, the "did you mean" of unknown flags and docs/cli.md. Aliases are second names of the same
+// option; the others are flags of their own (eval_command.cc) or only named in messages.
+constexpr std::array kEvo = std::to_array<EvoSpelling>({
+    {"-a", "--align se3 (with -s: --align sim3)", false},
+    {"--align", "--align se3 (cheval's --align takes a method; alone it means se3, as evo's)", false},
+    {"-s", "--align scale (with -a: --align sim3)", false},
+    {"--correct_scale", "--align scale (with -a: --align sim3)", false},
+    {"--align_origin", "--align origin", false},
+    {"--n_to_align", "--n-align", true},
+    {"--t_max_diff", "--t-max-diff", true},
+    {"--t_offset", "--t-offset", true},
+    {"--pose_relation", "--relation", true},
+    {"-d", "--delta", true},
+    {"--delta_unit", "--delta-unit", true},
+    {"--all_pairs", "--all-pairs", true},
+    {"--save_results", "--save-results", true},
+    {"--transform_left", "--transform-left", true},
+    {"--transform_right", "--transform-right", true},
+    {"-v", "accepted: cheval always prints what evo prints with -v", false},
+    {"--verbose", "accepted: cheval always prints what evo prints with -v", false},
+    {"--full_check", "--full-check", true},
+    {"-p", "no plot window: cheval report REF EST -o FILE.html", false},
+    {"--plot", "no plot window: cheval report REF EST -o FILE.html", false},
+});
+
+std::string Normalized(std::string_view flag) {
+  std::string out;
+  for (char c : flag) {
+    if (c == '-' || c == '_') continue;
+    out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  }
+  return out;
+}
+
+size_t EditDistance(std::string_view a, std::string_view b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
 }  // namespace
+
+std::span<const EvoSpelling> EvoSpellings() { return kEvo; }
+
+std::string Names(std::string_view field, std::string_view prefix, std::string_view short_name) {
+  return FlagNames(Flag(field, prefix), prefix.empty(), short_name);
+}
+
+std::string FlagNames(const std::string& flag, bool with_evo, std::string_view short_name) {
+  std::string names(short_name);
+  if (!names.empty()) names += ',';
+  names += flag;
+  if (!with_evo) return names;
+  for (const EvoSpelling& e : kEvo) {
+    if (e.alias && e.cheval == flag && e.evo != short_name) names.append(",").append(e.evo);
+  }
+  return names;
+}
+
+std::string UnknownFlagsMessage(const std::vector<std::string>& flags, const std::vector<std::string>& known,
+                                std::string_view command) {
+  std::string message;
+  for (const std::string& given : flags) {
+    const std::string flag = given.substr(0, given.find('='));
+    std::string hint;
+    for (const EvoSpelling& e : kEvo) {
+      if (e.evo == flag && !e.alias) hint = fmt::format("{} is evo's spelling; cheval: {}", flag, e.cheval);
+    }
+    if (hint.empty() && flag.size() > 1 && flag[0] == '-') {
+      const std::string wanted = Normalized(flag);
+      size_t best = std::string::npos;
+      std::string best_name;
+      for (const std::string& name : known) {
+        const size_t d = EditDistance(wanted, Normalized(name));
+        if (d < best) best = d, best_name = name;
+      }
+      if (!best_name.empty() && best <= std::max<size_t>(2, wanted.size() / 3)) {
+        hint = fmt::format("{} is not a flag of this command; did you mean {}?", flag, best_name);
+      }
+    }
+    if (hint.empty()) hint = fmt::format("the argument {} was not expected", given);
+    message += (message.empty() ? "" : "\n") + std::string("cheval: error: ") + hint;
+  }
+  return message + fmt::format("\nRun 'cheval {}--help' for the flags.", command.empty() ? "" : std::string(command) + " ");
+}
 
 std::string Flag(std::string_view field, std::string_view prefix) {
   for (const OptionName& entry : kFlags) {

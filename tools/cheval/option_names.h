@@ -8,6 +8,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "cheval/common/option_names.h"
 
@@ -23,5 +24,31 @@ std::string Spell(std::string_view message);
 
 /// The table, for library functions that quote messages in their output (report::ReportOptions).
 std::span<const OptionName> FlagNames();
+
+/// One of evo's spellings and what cheval spells for it (docs/cli.md, "evo's flags"). `cheval` is
+/// the cheval flag the evo spelling is an alias of (the same option, so the same result), or a
+/// note for the spellings that are not plain aliases (-a, -s, -v, --align_origin, -p).
+struct EvoSpelling {
+  std::string_view evo;
+  std::string_view cheval;
+  /// True when `evo` is registered as a second name of the option `cheval` (same value syntax).
+  bool alias;
+};
+
+/// Every evo spelling cheval knows, in the order of docs/cli.md.
+std::span<const EvoSpelling> EvoSpellings();
+
+/// The CLI11 names of the option of `field` (Flag(field, prefix)) followed by its evo aliases from
+/// EvoSpellings, e.g. "--t-max-diff,--t_max_diff"; `short_name` ("-r") goes first when given.
+std::string Names(std::string_view field, std::string_view prefix = "", std::string_view short_name = "");
+
+/// The CLI11 names of `flag` (a flag without a library field) and, when `with_evo`, its evo aliases.
+std::string FlagNames(const std::string& flag, bool with_evo = true, std::string_view short_name = "");
+
+/// The message for flags a command does not take: for each, the cheval spelling when it is one of
+/// evo's (EvoSpellings), else the closest flag of `command` ("did you mean"), and a pointer to
+/// `cheval COMMAND --help`. `command` empty for the top level.
+std::string UnknownFlagsMessage(const std::vector<std::string>& flags, const std::vector<std::string>& known,
+                                std::string_view command);
 
 }  // namespace cheval::cli

@@ -59,6 +59,10 @@ struct EvaluationOptions {
   bool estimate_velocity_body_frame = false;
   /// ASE without velocity (rotation + position only) instead of an error when velocity is missing.
   bool pose_only = false;
+  /// ASE: a reference whose orientations are all exactly the identity (what a position-only source
+  /// written with identity quaternions looks like) is treated as position-only, with a warning in
+  /// EvaluationResult::warnings; false takes those orientations as real.
+  bool identity_reference_is_position_only = true;
 
   /// Checks the fields and combinations a caller can get wrong, before any work (Evaluate calls it):
   /// association, alignment, RPE (metric kRpe) and velocity options, pose_only together with a
@@ -95,8 +99,11 @@ struct EvaluationResult {
   std::optional<AseErrors> ase;
   ErrorStatistics rotation_stats, position_stats, velocity_stats;
   std::string velocity_source;
-  /// RPE with kitti_drift.
+  /// RPE with kitti_drift (segments 0 when the reference path is shorter than 100 m: no drift).
   std::optional<DriftResult> drift;
+  /// What the caller should show the user, one line each (e.g. an identity-orientation reference
+  /// taken as position-only).
+  std::vector<std::string> warnings;
 };
 
 /// Evaluates `est` against `ref`. Throws OptionError for bad options (options.Validate()) and
@@ -111,6 +118,9 @@ struct EvaluationReport {
   std::string reference_path;
   Eigen::Index reference_poses = 0;
   std::string estimate_path;
+  /// The estimate's name in tables (`--label`, default the file name); in the JSON as
+  /// `estimate.label` when not empty.
+  std::string estimate_label;
   Eigen::Index estimate_poses = 0;
   EvaluationOptions options;
   EvaluationResult result;
