@@ -28,10 +28,16 @@ void Run(CLI::App* command, const ReportFlags& flags) {
   options.Validate();
   RefuseSharedPaths(EvalInputPaths(flags.eval), {{"-o", flags.output}});
   const EvalInputs inputs = ReadEvalInputs(command, flags.eval);
+  // Ties decided as evo would read the files (OptionsForEstimate). The report takes one set of
+  // options: the estimates' formats decide it when they agree (they differ only in a mixed-format
+  // report, where the first estimate's reading is used).
+  options.ape = OptionsForEstimate(options.ape, inputs, 0);
+  options.ase = OptionsForEstimate(options.ase, inputs, 0);
   std::vector<report::ReportInput> estimates;
   for (size_t k = 0; k < inputs.estimates.size(); ++k) {
-    // The label: empty, the file name (report::ReportInput::label).
-    estimates.push_back({inputs.estimate_names[k], inputs.estimates[k].View(), ""});
+    // The label: --label's, else empty (the page's own short name, report::ReportInput::label).
+    estimates.push_back({inputs.estimate_names[k], inputs.estimates[k].View(),
+                         flags.eval.labels.empty() ? std::string() : inputs.estimate_labels[k]});
   }
   const report::Report result =
       report::BuildReport({flags.eval.reference, inputs.reference.View(), ""}, estimates, options);
