@@ -37,11 +37,14 @@ struct PositionMeasurement {
 };
 
 // The onboard attitude (rows 0–2: the rotation error vee(skew(R_measᵀ R)), = Log(R_measᵀ R) to second
-// order) and body rate (rows 3–5), whitened.
-struct AttitudeRateMeasurement {
+// order), body rate (rows 3–5) and, when the sample has a fresh one, the motion-capture position (rows
+// 6–8; else 0), whitened: one residual block per sample.
+struct SampleMeasurement {
   Eigen::Matrix3d measured_transpose;
   Eigen::Vector3d w;
   double inv_attitude, inv_rate;
+  bool has_position;
+  PositionMeasurement position;
   template <typename T>
   bool operator()(const T* x, const Eigen::Matrix<T, 3, 3>& R, T* r) const {
     const Eigen::Matrix<T, 3, 3> M = measured_transpose.cast<T>() * R;
@@ -49,6 +52,8 @@ struct AttitudeRateMeasurement {
     r[1] = T(0.5 * inv_attitude) * (M(0, 2) - M(2, 0));
     r[2] = T(0.5 * inv_attitude) * (M(1, 0) - M(0, 1));
     for (int i = 0; i < 3; ++i) r[3 + i] = (x[6 + i] - T(w[i])) * T(inv_rate);
+    if (has_position) return position(x, R, r + 6);
+    for (int i = 6; i < 9; ++i) r[i] = T(0);
     return true;
   }
 };
@@ -71,6 +76,31 @@ class ThetaPrior : public internal::BlockCost {
 
  private:
   RotorThetaVector mean_, sigma_;
+};
+
+// (Ω(t) − Ω_measured) / σ with Ω(t) = Σ_k w_k(t) U_k: a measured rotor speed at any time.
+class RotorSpeedMeasurement : public internal::BlockCost {
+ public:
+  RotorSpeedMeasurement(const internal::Segment& segment, Eigen::RowVectorXd w, const Eigen::Vector4d& measured,
+                        double sigma)
+      : w_(std::move(w)), measured_(measured), inv_sigma_(1.0 / sigma) {
+    for (double* control : segment.control) AddBlock(control, 4);
+    set_num_residuals(4);
+  }
+  bool Evaluate(double const* const* p, double* r, double** J) const override {
+    Eigen::Vector4d u = -measured_;
+    for (int k = 0; k < w_.size(); ++k) u += w_[k] * Eigen::Map<const Eigen::Vector4d>(p[k]);
+    Eigen::Map<Eigen::Vector4d>{r} = inv_sigma_ * u;
+    for (int k = 0; J && k < w_.size(); ++k) {
+      if (J[k]) Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>{J[k]} = inv_sigma_ * w_[k] * Eigen::Matrix4d::Identity();
+    }
+    return true;
+  }
+
+ private:
+  Eigen::RowVectorXd w_;
+  Eigen::Vector4d measured_;
+  double inv_sigma_;
 };
 
 RotorThetaVector PriorSigma() {
@@ -130,10 +160,10 @@ std::unique_ptr<Problem> BuildProblem(const RotorFlight& flight, size_t first, s
   problem->SetChartReferences();
   for (size_t i = first; i <= last; ++i) {
     problem->AddMeasurement(s[i].t,
-                            AttitudeRateMeasurement{s[i].q.toRotationMatrix().transpose(), s[i].w,
-                                                    1.0 / o.attitude_sigma_rad, 1.0 / o.rate_sigma_radps},
-                            6, 3, {2}, loss);
-    if (s[i].fresh_position) problem->AddMeasurement(s[i].t, PositionMeasurement{s[i].p, 1.0 / o.position_sigma_m}, 3, 3, {0}, loss);
+                            SampleMeasurement{s[i].q.toRotationMatrix().transpose(), s[i].w, 1.0 / o.attitude_sigma_rad,
+                                              1.0 / o.rate_sigma_radps, s[i].fresh_position,
+                                              PositionMeasurement{s[i].p, 1.0 / o.position_sigma_m}},
+                            9, 3, {0, 2}, loss);
   }
   return problem;
 }
@@ -152,6 +182,7 @@ ceres::Solver::Options SolverOptions(const RotorEstimateOptions& o) {
   solver.num_threads = o.threads;
   solver.logging_type = ceres::SILENT;
   solver.initial_trust_region_radius = 1e8;
+  solver.function_tolerance = o.function_tolerance;
   return solver;
 }
 
@@ -165,6 +196,7 @@ void RotorEstimateOptions::Validate() const {
   check(positive(position_sigma_m), "position_sigma_m", "must be > 0, got {}", position_sigma_m);
   check(positive(attitude_sigma_rad), "attitude_sigma_rad", "must be > 0, got {}", attitude_sigma_rad);
   check(positive(rate_sigma_radps), "rate_sigma_radps", "must be > 0, got {}", rate_sigma_radps);
+  check(positive(rotor_sigma_radps), "rotor_sigma_radps", "must be > 0, got {}", rotor_sigma_radps);
   check(positive(huber), "huber", "must be > 0, got {}", huber);
   check(positive(sigma_position_rate), "sigma_position_rate", "must be > 0, got {}", sigma_position_rate);
   check(positive(sigma_acceleration), "sigma_acceleration", "must be > 0, got {}", sigma_acceleration);
@@ -174,6 +206,7 @@ void RotorEstimateOptions::Validate() const {
   check(positive(sigma_rotor_rate), "sigma_rotor_rate", "must be > 0, got {}", sigma_rotor_rate);
   check(positive(baseline_window_s), "baseline_window_s", "must be > 0, got {}", baseline_window_s);
   check(score_margin_s >= 0 && std::isfinite(score_margin_s), "score_margin_s", "must be >= 0, got {}", score_margin_s);
+  check(positive(function_tolerance), "function_tolerance", "must be > 0, got {}", function_tolerance);
   check(max_iterations >= 1, "max_iterations", "must be >= 1, got {}", max_iterations);
   check(threads >= 1, "threads", "must be >= 1, got {}", threads);
 }
@@ -230,7 +263,7 @@ RotorEstimate EstimateRotors(const RotorFlight& flight, const RotorVehicle& vehi
 
 namespace {
 
-// θ from one flight: the trajectory and θ jointly, the measured rotor speeds held as known inputs.
+// θ from one flight: the trajectory, its rotor speeds and θ jointly, the rotor speeds measured.
 RotorIdentification IdentifyOne(const RotorFlight& flight, const RotorVehicle& base, const RotorEstimateOptions& o) {
   const auto start = Clock::now();
   const RotorModel model{base.nominal, base.theta};
@@ -261,7 +294,11 @@ RotorIdentification IdentifyOne(const RotorFlight& flight, const RotorVehicle& b
     for (int i = 0; i < 3; ++i) {  // a rigid body's inertia is positive: at least 1 % of the published one
       problem->ceres_problem().SetParameterLowerBound(theta.data(), kThetaInertiaX + i, 0.01);
     }
-    for (int g = 0; g < problem->num_nodes(); ++g) problem->ceres_problem().SetParameterBlockConstant(problem->Control(g));
+    for (size_t i = first; i <= last; ++i) {
+      const internal::TimeRow row = problem->RowAt(flight.samples[i].t);
+      problem->AddPrior(std::make_unique<RotorSpeedMeasurement>(problem->SegmentOf(row.segment), row.w,
+                                                                flight.samples[i].rotor, o.rotor_sigma_radps));
+    }
     const ceres::Solver::Summary summary = problem->Solve(SolverOptions(o));
     id.converged = summary.termination_type == ceres::CONVERGENCE;
     cost += summary.final_cost;

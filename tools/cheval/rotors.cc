@@ -33,6 +33,8 @@ void AddModelOptions(CLI::App* command, estim::RotorEstimateOptions& o) {
   command->add_option("--sigma-angular-acceleration", o.sigma_angular_acceleration,
                       "Collocation sigma of the body rate's derivative (rad/s^2)")
       ->capture_default_str();
+  command->add_option("--max-iterations", o.max_iterations, "Levenberg-Marquardt iterations at most")
+      ->capture_default_str();
   command->add_option("--baseline-window", o.baseline_window_s, "Window of the flatness baseline's fits (s)")
       ->capture_default_str();
 }
@@ -78,9 +80,12 @@ void RegisterEstimateRotors(CLI::App& app, Action* action) {
       fmt::print("rotor error %       {}\n", Row(e.error.percent, "{:.3f} {:.3f} {:.3f} {:.3f}"));
       fmt::print("flatness rpm        {}\n", Row(e.baseline.rpm, "{:.1f} {:.1f} {:.1f} {:.1f}"));
       fmt::print("flatness %          {}\n", Row(e.baseline.percent, "{:.3f} {:.3f} {:.3f} {:.3f}"));
+      // OutputFile holds a view: the texts live here until written.
+      const std::string json = flags->json.empty() ? "" : estim::RotorEstimateJson(e, flight);
+      const std::string csv = flags->output.empty() ? "" : estim::RotorStatesCsv(e);
       std::vector<OutputFile> files;
-      if (!flags->json.empty()) files.push_back({flags->json, estim::RotorEstimateJson(e, flight)});
-      if (!flags->output.empty()) files.push_back({flags->output, estim::RotorStatesCsv(e)});
+      if (!flags->json.empty()) files.push_back({flags->json, json});
+      if (!flags->output.empty()) files.push_back({flags->output, csv});
       if (!files.empty()) WriteOutputs(files);
     };
   });
@@ -97,6 +102,8 @@ void RegisterIdentifyRotors(CLI::App& app, Action* action) {
   rotors->add_option("--vehicle", flags->vehicle, "Base vehicle file (the published parameters)")->required();
   rotors->add_option("-o,--output", flags->output, "The identified vehicle file (JSON)")->required();
   AddModelOptions(rotors, flags->options);
+  rotors->add_option("--rotor-sigma", flags->options.rotor_sigma_radps, "Sigma of a measured rotor speed (rad/s)")
+      ->capture_default_str();
   rotors->callback([flags, action] {
     *action = [flags] {
       std::vector<std::string> inputs = flags->data;
