@@ -101,7 +101,9 @@ TEST(RotorIdentification, RecoversPerturbedParameters) {
   base.nominal.moment_coefficient *= 0.6;
   base.nominal.inertia_kgm2 = base.nominal.inertia_kgm2.cwiseProduct(Eigen::Vector3d(0.8, 1.25, 1.5));
   std::vector<estim::RotorIdentification> per_flight;
-  const estim::RotorVehicle id = estim::IdentifyRotors({flight}, base, {}, &per_flight);
+  estim::RotorEstimateOptions options;
+  options.rotor_sigma_radps = 1.0;  // the simulator's rotor speeds are exact (the default 30 is for ESC telemetry)
+  const estim::RotorVehicle id = estim::IdentifyRotors({flight}, base, options, &per_flight);
   ASSERT_EQ(per_flight.size(), 1u);
   // The collective thrust coefficient is what the translation sees: within 1 %.
   EXPECT_NEAR(id.theta.head<4>().mean() * base.nominal.thrust_coefficient / truth.thrust_coefficient, 1.0, 0.01);
