@@ -65,6 +65,7 @@ void RegisterEstimateRotors(CLI::App& app, Action* action) {
   rotors->add_option("-o,--output", flags->output, "Write states and rotor speeds (estimated, measured, baseline) as CSV");
   rotors->callback([flags, action] {
     *action = [flags] {
+      flags->options.Validate();
       RefuseSharedPaths({flags->data[0], flags->vehicle}, {{"--json", flags->json}, {"-o", flags->output}});
       const estim::RotorVehicle vehicle = estim::ReadRotorVehicle(flags->vehicle);
       const estim::RotorFlight flight = estim::ReadRotorFlight(flags->data[0]);
@@ -108,6 +109,7 @@ void RegisterIdentifyRotors(CLI::App& app, Action* action) {
     *action = [flags] {
       std::vector<std::string> inputs = flags->data;
       inputs.push_back(flags->vehicle);
+      flags->options.Validate();
       RefuseSharedPaths(inputs, {{"-o", flags->output}});
       const estim::RotorVehicle base = estim::ReadRotorVehicle(flags->vehicle);
       std::vector<estim::RotorFlight> flights;
