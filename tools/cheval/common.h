@@ -73,3 +73,8 @@ void RegisterEstimate(CLI::App& app, Action* action);
 void RegisterEstimateThrust(CLI::App& app, Action* action);
 
 }  // namespace cheval::cli
+namespace cheval::cli {
+/// `cheval estimate rotors` (needs RegisterEstimate first) and `cheval identify rotors` (tools/cheval/rotors.cc).
+void RegisterEstimateRotors(CLI::App& app, Action* action);
+void RegisterIdentifyRotors(CLI::App& app, Action* action);
+}  // namespace cheval::cli

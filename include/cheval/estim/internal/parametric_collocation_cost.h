@@ -1,0 +1,110 @@
+#pragma once
+/// \file
+/// ParametricCollocationCost: the collocation defect of one vector block of the rotor model
+/// (rotor_model.h) at one node, with the model's parameters θ as a parameter block of their own — the
+/// residual that lets `identify rotors` estimate θ jointly with the trajectory.
+///
+/// Contract. For node j of a segment (point order, segment.h) and vector block b (1: v, 2: ω):
+///   ((D X_b)_j − f_b(X_j, R_j, U_j; θ)) / σ_b,
+/// exactly CollocationCost's vector-block residual (collocation_cost.h) with f = RotorDynamics.
+/// Parameter blocks: block b at the N + 1 nodes (point order), node j's other two vector blocks, its
+/// quaternion (x, y, z, w), its control, then θ (kRotorThetaSize). Jacobians analytic through D; f by
+/// ceres::Jet in (x_j, δ_j, u_j, θ), the rotation's lifted to the quaternion (LiftRotationJacobian).
+
+#include <ceres/jet.h>
+#include <Eigen/Core>
+
+#include "cheval/estim/internal/block_cost.h"
+#include "cheval/estim/internal/segment.h"
+#include "cheval/estim/manifold.h"
+#include "cheval/estim/rotor_model.h"
+#include "cheval/lie/so3.h"
+
+namespace cheval::estim::internal {
+
+class ParametricCollocationCost : public BlockCost {
+  static constexpr int kJet = 9 + 3 + 4 + kRotorThetaSize;
+
+ public:
+  /// `D`: the segment's differentiation matrix on the unit interval; `part` 1 or 2; `sigma` > 0.
+  ParametricCollocationCost(const RotorNominal& nominal, const Segment& segment, const Eigen::MatrixXd& D, int j,
+                            int part, double sigma, double* theta)
+      : nominal_(nominal), degree_(segment.degree()), scale_(segment.derivative_scale), d_(D.row(j)), j_(j),
+        part_(part), inv_sigma_(1.0 / sigma) {
+    for (int k = 0; k <= degree_; ++k) AddBlock(segment.vector[k] + 3 * part, 3);
+    for (int b = 0; b < 3; ++b) {
+      if (b != part) AddBlock(segment.vector[j] + 3 * b, 3);
+    }
+    AddBlock(segment.quaternion[j], 4);
+    AddBlock(segment.control[j], 4);
+    AddBlock(theta, kRotorThetaSize);
+    set_num_residuals(3);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const int N = degree_;
+    using Jet = ceres::Jet<double, kJet>;
+    Jet x[9], u[4], theta[kRotorThetaSize], x_dot[9];
+    int next = N + 1;
+    for (int i = 0; i < 3; ++i) x[3 * part_ + i] = Jet(parameters[j_][i], 3 * part_ + i);
+    for (int b = 0; b < 3; ++b) {
+      if (b == part_) continue;
+      for (int i = 0; i < 3; ++i) x[3 * b + i] = Jet(parameters[next][i], 3 * b + i);
+      ++next;
+    }
+    const double* q = parameters[next++];
+    const double* control = parameters[next++];
+    const double* th = parameters[next];
+    for (int i = 0; i < 4; ++i) u[i] = Jet(control[i], 12 + i);
+    for (int i = 0; i < kRotorThetaSize; ++i) theta[i] = Jet(th[i], 16 + i);
+    Eigen::Matrix<Jet, 3, 1> delta;
+    for (int i = 0; i < 3; ++i) delta[i] = Jet(0.0, 9 + i);
+    const Eigen::Matrix<Jet, 3, 3> R = QuaternionMatrix(q).cast<Jet>() * lie::SO3<Jet>::Exp(delta).Matrix();
+    RotorDynamics(nominal_, x, R, u, theta, x_dot);
+    Eigen::Vector3d r;
+    for (int i = 0; i < 3; ++i) r[i] = -x_dot[3 * part_ + i].a;
+    for (int k = 0; k <= N; ++k) r += scale_ * d_[k] * Eigen::Map<const Eigen::Vector3d>(parameters[k]);
+    Eigen::Map<Eigen::Vector3d>{residuals} = inv_sigma_ * r;
+    if (jacobians == nullptr) return true;
+    Eigen::Matrix<double, 3, kJet> df;
+    for (int i = 0; i < 3; ++i) df.row(i) = x_dot[3 * part_ + i].v.transpose();
+    df *= -inv_sigma_;
+    using RowMajor3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+    for (int k = 0; k <= N; ++k) {
+      if (jacobians[k] == nullptr) continue;
+      RowMajor3 J = (inv_sigma_ * scale_ * d_[k]) * RowMajor3::Identity();
+      if (k == j_) J += df.block<3, 3>(0, 3 * part_);
+      Eigen::Map<RowMajor3>{jacobians[k]} = J;
+    }
+    next = N + 1;
+    for (int b = 0; b < 3; ++b) {
+      if (b == part_) continue;
+      if (jacobians[next]) Eigen::Map<RowMajor3>{jacobians[next]} = df.block<3, 3>(0, 3 * b);
+      ++next;
+    }
+    if (jacobians[next]) {
+      const RowMajor3 Jd = df.block<3, 3>(0, 9);
+      LiftRotationJacobian(q, Jd.data(), 3, jacobians[next]);
+    }
+    ++next;
+    if (jacobians[next]) {
+      Eigen::Map<Eigen::Matrix<double, 3, 4, Eigen::RowMajor>>{jacobians[next]} = df.block<3, 4>(0, 12);
+    }
+    ++next;
+    if (jacobians[next]) {
+      Eigen::Map<Eigen::Matrix<double, 3, kRotorThetaSize, Eigen::RowMajor>>{jacobians[next]} =
+          df.block<3, kRotorThetaSize>(0, 16);
+    }
+    return true;
+  }
+
+ private:
+  RotorNominal nominal_;
+  int degree_;
+  double scale_;
+  Eigen::RowVectorXd d_;
+  int j_, part_;
+  double inv_sigma_;
+};
+
+}  // namespace cheval::estim::internal

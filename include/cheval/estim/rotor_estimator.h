@@ -1,0 +1,142 @@
+#pragma once
+/// \file
+/// All four rotor speeds of a real quadrotor from motion capture, its onboard attitude and body
+/// rates and the rigid-body dynamics (rotor_model.h) on the pseudo-spectral problem (problem.h), the
+/// identification of the model's parameters from flights with measured rotor speeds, and the flatness
+/// baseline they are compared with (docs/estimator_real_data.md, "Rotor speeds of a Crazyflie").
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "cheval/estim/crazyflie_data.h"
+#include "cheval/estim/rotor_model.h"
+
+namespace cheval::estim {
+
+/// A vehicle file for `estimate rotors` / `identify rotors` (JSON; docs/estimator_real_data.md has
+/// the keys): the published constants and θ, with θ's standard deviations when identified.
+struct RotorVehicle {
+  std::string name, source;
+  RotorNominal nominal;
+  RotorThetaVector theta = RotorNominal::PublishedTheta();
+  RotorThetaVector theta_sigma = RotorThetaVector::Zero();  ///< 0: not identified
+  std::vector<std::string> training;                        ///< flights θ was identified on
+};
+
+/// Reads a rotor vehicle file. Throws InputError (`path:0:0: error: ...`) for an unreadable or
+/// invalid file, an unknown, missing or non-numeric key, or a value out of its range.
+RotorVehicle ReadRotorVehicle(const std::string& path);
+/// The vehicle as JSON text, readable by ReadRotorVehicle.
+std::string RotorVehicleToJson(const RotorVehicle& vehicle);
+
+/// Options of EstimateRotors and IdentifyRotors (one set for every flight; the docs say why).
+struct RotorEstimateOptions {
+  int degree = 5;            ///< polynomial degree per segment, in [2, 20]
+  double segment_s = 0.25;   ///< segment length, s (> 0)
+  double position_sigma_m = 0.003;     ///< σ of a motion-capture position (> 0)
+  double attitude_sigma_rad = 0.01;    ///< σ of the onboard attitude (> 0)
+  double rate_sigma_radps = 0.05;      ///< σ of a body-rate sample (> 0)
+  /// σ of a measured rotor speed in the identification, rad/s (> 0): the ESC's telemetry and the
+  /// part of the rotor speeds the model does not explain (errors in variables, not held inputs).
+  double rotor_sigma_radps = 30.0;
+  double huber = 3.0;                  ///< Huber threshold of each measurement, in σ (> 0)
+  /// Collocation σ (> 0): p' (m/s), v' (m/s²), ω' (rad/s²), body rate of R (rad/s).
+  double sigma_position_rate = 1e-3, sigma_acceleration = 0.3, sigma_angular_acceleration = 3.0,
+         sigma_rotation_rate = 1e-3;
+  /// σ of the rotor-speed prior ∫ |Ω'|² dt / σ² (estimation only), rad/s² per s^(1/2) (> 0).
+  double sigma_rotor_rate = 3000.0;
+  double baseline_window_s = 0.2;  ///< window of the flatness baseline's local fits, s (> 0)
+  double score_margin_s = 0.5;     ///< scored samples: flying, this far from a span's ends (>= 0)
+  /// Levenberg–Marquardt iterations (>= 1). On the shared flights the rotor speeds after 6 iterations
+  /// differ from those after 30 by < 0.1 % of the speed (docs/estimator_real_data.md).
+  int max_iterations = 8;
+  /// Ceres' relative cost-change tolerance (> 0): the rotor speeds settle to 0.01 % within ~3
+  /// iterations from the flatness start, and Ceres' default 1e-6 spends 20–30 more on the Huber tails.
+  double function_tolerance = 1e-3;
+  int threads = 1;                 ///< >= 1
+  /// Throws OptionError naming the first field out of its range.
+  void Validate() const;
+};
+
+/// Per-motor mean absolute error over the scored samples.
+struct RotorError {
+  Eigen::Vector4d rpm = Eigen::Vector4d::Zero();
+  Eigen::Vector4d percent = Eigen::Vector4d::Zero();  ///< of the measured speed, per sample
+};
+
+/// The estimate at one sample of the flight.
+struct RotorStateEstimate {
+  double t = 0;
+  Eigen::Vector3d p, v, w;
+  Eigen::Quaterniond q;
+  Eigen::Vector4d rotor;     ///< estimated m1..m4, rad/s
+  Eigen::Vector4d measured;  ///< the flight's, rad/s
+  Eigen::Vector4d baseline;  ///< the flatness baseline's, rad/s
+  bool scored = false;       ///< in the scored samples
+};
+
+/// What EstimateRotors returns.
+struct RotorEstimate {
+  RotorError error;                 ///< the estimate's
+  RotorError baseline;              ///< the flatness baseline's, on the same samples
+  double seconds = 0;               ///< wall time of the estimate (not of the baseline)
+  double duration_s = 0;            ///< the estimated span(s), s
+  int states = 0, segments = 0, iterations = 0, scored_samples = 0;
+  bool converged = false;
+  std::vector<RotorStateEstimate> samples;  ///< at every sample inside a flying span
+};
+
+/// Rotor speeds m1..m4 (rad/s) at every sample by differential flatness with parameters θ: local
+/// least-squares fits within `window_s` around each sample — quadratic of the fresh motion-capture
+/// positions (a), linear of the body rates (ω') — then T = m (Rᵀ(a − g))_z (+ rotor drag), τ = Jω' +
+/// ω × Jω − τ0 and the mixer inverted for Ω² (negative values give 0). With the published θ this is
+/// the baseline of the issue: twice-differentiated positions and once-differentiated rates through the
+/// published mixer.
+std::vector<Eigen::Vector4d> FlatnessRotorSpeeds(const RotorFlight& flight, const RotorNominal& nominal,
+                                                 const RotorThetaVector& theta, double window_s);
+
+/// Per-motor mean absolute error of `estimate` against the measured speeds over `indices`.
+RotorError ScoreRotors(const RotorFlight& flight, const std::vector<Eigen::Vector4d>& estimate,
+                       const std::vector<size_t>& indices);
+
+/// Estimates states and rotor speeds over each flying span of the flight, with θ known (the vehicle's),
+/// without looking at the measured rotor speeds; scores them and the baseline. Throws OptionError for
+/// bad options, ComputeError when no flying span is longer than 2 · score_margin_s + 0.1 s.
+RotorEstimate EstimateRotors(const RotorFlight& flight, const RotorVehicle& vehicle, const RotorEstimateOptions& options);
+
+/// θ identified from one flight, with its covariance.
+struct RotorIdentification {
+  RotorThetaVector theta = RotorThetaVector::Zero();
+  Eigen::Matrix<double, kRotorThetaSize, kRotorThetaSize> covariance;  ///< scaled by the reduced χ²
+  double reduced_chi2 = 0;
+  double seconds = 0;
+  bool converged = false;
+};
+
+/// Identifies θ on each flight jointly with its trajectory and rotor speeds (the measured rotor speeds
+/// as measurements with σ rotor_sigma_radps; a weak prior keeps θ within reach of the published vehicle: σ 1 on the relative entries,
+/// 100 units on τ0 and drag), then combines the flights by their information (the product of the
+/// Gaussian marginals of θ). Returns the vehicle with the combined θ and σ, and `per_flight` each
+/// flight's own. ComputeError when a covariance cannot be computed.
+RotorVehicle IdentifyRotors(const std::vector<RotorFlight>& flights, const RotorVehicle& base,
+                            const RotorEstimateOptions& options, std::vector<RotorIdentification>* per_flight);
+
+}  // namespace cheval::estim
+
+namespace cheval::estim {
+
+/// The `estimate rotors --json` object: `rotor_error_percent`, `flatness_error_percent` (4 each, m1..m4),
+/// `rotor_error_rpm`, `flatness_error_rpm`, `seconds`, `duration_s`, `states`, `segments`,
+/// `iterations`, `converged`, `scored_samples`, `dropped_rows` (file lines of rows with missing
+/// values) and `flying_spans` ([first, last] s each).
+std::string RotorEstimateJson(const RotorEstimate& estimate, const RotorFlight& flight);
+
+/// The `-o` CSV: `t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz` (estimated; world position and velocity,
+/// R_world_body, body rate), `rotor1..4` (estimated, rad/s), `measured1..4`, `baseline1..4` (the
+/// flatness baseline), `scored` (1 for the scored samples): one row per sample inside a flying span,
+/// everything a figure of estimated against measured speeds per motor needs.
+std::string RotorStatesCsv(const RotorEstimate& estimate);
+
+}  // namespace cheval::estim

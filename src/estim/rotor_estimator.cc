@@ -1,0 +1,352 @@
+// EstimateRotors and IdentifyRotors (rotor_estimator.h): the rotor model (rotor_model.h) on the
+// pseudo-spectral problem (problem.h), measured by motion capture, the onboard attitude and body rates.
+#include "cheval/estim/rotor_estimator.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+#include <ceres/covariance.h>
+#include <Eigen/Dense>
+
+#include "cheval/cheb/chebyshev.h"
+#include "cheval/common/error.h"
+#include "cheval/common/options.h"
+#include "cheval/estim/internal/parametric_collocation_cost.h"
+#include "cheval/estim/problem.h"
+#include "rotor_internal.h"
+
+namespace cheval::estim {
+namespace {
+
+using Problem = PseudoSpectralProblem<RotorModel>;
+using Clock = std::chrono::steady_clock;
+
+// A motion-capture position, whitened.
+struct PositionMeasurement {
+  Eigen::Vector3d p;
+  double inv_sigma;
+  template <typename T>
+  bool operator()(const T* x, const Eigen::Matrix<T, 3, 3>& /*R*/, T* r) const {
+    for (int i = 0; i < 3; ++i) r[i] = (x[i] - T(p[i])) * T(inv_sigma);
+    return true;
+  }
+};
+
+// The onboard attitude (rows 0–2: the rotation error vee(skew(R_measᵀ R)), = Log(R_measᵀ R) to second
+// order), body rate (rows 3–5) and, when the sample has a fresh one, the motion-capture position (rows
+// 6–8; else 0), whitened: one residual block per sample.
+struct SampleMeasurement {
+  Eigen::Matrix3d measured_transpose;
+  Eigen::Vector3d w;
+  double inv_attitude, inv_rate;
+  bool has_position;
+  PositionMeasurement position;
+  template <typename T>
+  bool operator()(const T* x, const Eigen::Matrix<T, 3, 3>& R, T* r) const {
+    const Eigen::Matrix<T, 3, 3> M = measured_transpose.cast<T>() * R;
+    r[0] = T(0.5 * inv_attitude) * (M(2, 1) - M(1, 2));
+    r[1] = T(0.5 * inv_attitude) * (M(0, 2) - M(2, 0));
+    r[2] = T(0.5 * inv_attitude) * (M(1, 0) - M(0, 1));
+    for (int i = 0; i < 3; ++i) r[3 + i] = (x[6 + i] - T(w[i])) * T(inv_rate);
+    if (has_position) return position(x, R, r + 6);
+    for (int i = 6; i < 9; ++i) r[i] = T(0);
+    return true;
+  }
+};
+
+// (θ − θ0) / σ: the weak prior of the identification.
+class ThetaPrior : public internal::BlockCost {
+ public:
+  ThetaPrior(double* theta, const RotorThetaVector& mean, const RotorThetaVector& sigma) : mean_(mean), sigma_(sigma) {
+    AddBlock(theta, kRotorThetaSize);
+    set_num_residuals(kRotorThetaSize);
+  }
+  bool Evaluate(double const* const* p, double* r, double** J) const override {
+    for (int i = 0; i < kRotorThetaSize; ++i) r[i] = (p[0][i] - mean_[i]) / sigma_[i];
+    if (J && J[0]) {
+      Eigen::Map<Eigen::Matrix<double, kRotorThetaSize, kRotorThetaSize, Eigen::RowMajor>> m{J[0]};
+      m = sigma_.cwiseInverse().asDiagonal();
+    }
+    return true;
+  }
+
+ private:
+  RotorThetaVector mean_, sigma_;
+};
+
+// (Ω(t) − Ω_measured) / σ with Ω(t) = Σ_k w_k(t) U_k: a measured rotor speed at any time.
+class RotorSpeedMeasurement : public internal::BlockCost {
+ public:
+  RotorSpeedMeasurement(const internal::Segment& segment, Eigen::RowVectorXd w, const Eigen::Vector4d& measured,
+                        double sigma)
+      : w_(std::move(w)), measured_(measured), inv_sigma_(1.0 / sigma) {
+    for (double* control : segment.control) AddBlock(control, 4);
+    set_num_residuals(4);
+  }
+  bool Evaluate(double const* const* p, double* r, double** J) const override {
+    Eigen::Vector4d u = -measured_;
+    for (int k = 0; k < w_.size(); ++k) u += w_[k] * Eigen::Map<const Eigen::Vector4d>(p[k]);
+    Eigen::Map<Eigen::Vector4d>{r} = inv_sigma_ * u;
+    for (int k = 0; J && k < w_.size(); ++k) {
+      if (J[k]) Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>{J[k]} = inv_sigma_ * w_[k] * Eigen::Matrix4d::Identity();
+    }
+    return true;
+  }
+
+ private:
+  Eigen::RowVectorXd w_;
+  Eigen::Vector4d measured_;
+  double inv_sigma_;
+};
+
+RotorThetaVector PriorSigma() {
+  RotorThetaVector s = RotorThetaVector::Constant(100.0);
+  s.head<8>().setOnes();
+  return s;
+}
+
+// The flying spans long enough to score, as [first, last] sample indices.
+std::vector<std::pair<size_t, size_t>> Spans(const RotorFlight& flight, double margin_s) {
+  std::vector<std::pair<size_t, size_t>> out;
+  const std::vector<RotorSample>& s = flight.samples;
+  for (size_t i = 0; i < s.size();) {
+    if (!s[i].flying) {
+      ++i;
+      continue;
+    }
+    size_t j = i;
+    while (j + 1 < s.size() && s[j + 1].flying) ++j;
+    if (s[j].t - s[i].t > 2 * margin_s + 0.1) out.push_back({i, j});
+    i = j + 1;
+  }
+  if (out.empty()) {
+    throw ComputeError(fmt::format("{}: no flying span (is_flying = 1) longer than {} s", flight.path,
+                                   2 * margin_s + 0.1));
+  }
+  return out;
+}
+
+// The problem over samples [first, last], initial values set, measurements added (no dynamics yet).
+std::unique_ptr<Problem> BuildProblem(const RotorFlight& flight, size_t first, size_t last, const RotorModel& model,
+                                      const RotorEstimateOptions& o, bool measured_rotors,
+                                      const ceres::LossFunction* loss) {
+  const std::vector<RotorSample>& s = flight.samples;
+  const double t0 = s[first].t, t1 = s[last].t;
+  const int segments = SegmentCount("RotorEstimateOptions", t1 - t0, o.segment_s, o.degree);
+  std::vector<double> breakpoints(segments + 1);
+  for (int k = 0; k <= segments; ++k) breakpoints[k] = t0 + (t1 - t0) * k / segments;
+  breakpoints.back() = t1;
+  auto problem = std::make_unique<Problem>(model, breakpoints, o.degree);
+  const Eigen::Vector3d g(0, 0, -model.nominal.gravity_mps2);
+  for (int n = 0; n < problem->num_nodes(); ++n) {
+    const double t = problem->NodeTime(n);
+    const rotor_internal::KinematicFit fit = rotor_internal::FitPosition(flight, t, o.baseline_window_s);
+    const RotorSample at = rotor_internal::SampleAt(flight, t);
+    Eigen::Vector3d w, w_dot;
+    rotor_internal::FitRate(flight, t, o.baseline_window_s, &w, &w_dot);
+    const Eigen::Matrix3d R = at.q.toRotationMatrix();
+    Eigen::VectorXd x(9);
+    x << fit.p, fit.v, at.w;
+    const Eigen::Vector4d rotor =
+        measured_rotors ? at.rotor
+                        : rotor_internal::InvertMixer(model.nominal, model.theta, (R.transpose() * (fit.a - g)).z(),
+                                                      R.transpose() * fit.v, at.w, w_dot);
+    problem->SetNode(n, x, R, rotor);
+  }
+  problem->SetChartReferences();
+  for (size_t i = first; i <= last; ++i) {
+    problem->AddMeasurement(s[i].t,
+                            SampleMeasurement{s[i].q.toRotationMatrix().transpose(), s[i].w, 1.0 / o.attitude_sigma_rad,
+                                              1.0 / o.rate_sigma_radps, s[i].fresh_position,
+                                              PositionMeasurement{s[i].p, 1.0 / o.position_sigma_m}},
+                            9, 3, {0, 2}, loss);
+  }
+  return problem;
+}
+
+Eigen::Matrix<double, 12, 1> CollocationSigma(const RotorEstimateOptions& o) {
+  Eigen::Matrix<double, 12, 1> sigma;
+  sigma << Eigen::Vector3d::Constant(o.sigma_position_rate), Eigen::Vector3d::Constant(o.sigma_acceleration),
+      Eigen::Vector3d::Constant(o.sigma_angular_acceleration), Eigen::Vector3d::Constant(o.sigma_rotation_rate);
+  return sigma;
+}
+
+ceres::Solver::Options SolverOptions(const RotorEstimateOptions& o) {
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  solver.max_num_iterations = o.max_iterations;
+  solver.num_threads = o.threads;
+  solver.logging_type = ceres::SILENT;
+  solver.initial_trust_region_radius = 1e8;
+  solver.function_tolerance = o.function_tolerance;
+  return solver;
+}
+
+}  // namespace
+
+void RotorEstimateOptions::Validate() const {
+  const OptionCheck check("RotorEstimateOptions");
+  const auto positive = [](double x) { return x > 0 && std::isfinite(x); };
+  check(degree >= 2 && degree <= 20, "degree", "must be in [2, 20], got {}", degree);
+  check(positive(segment_s), "segment_s", "must be a positive number of seconds, got {}", segment_s);
+  check(positive(position_sigma_m), "position_sigma_m", "must be > 0, got {}", position_sigma_m);
+  check(positive(attitude_sigma_rad), "attitude_sigma_rad", "must be > 0, got {}", attitude_sigma_rad);
+  check(positive(rate_sigma_radps), "rate_sigma_radps", "must be > 0, got {}", rate_sigma_radps);
+  check(positive(rotor_sigma_radps), "rotor_sigma_radps", "must be > 0, got {}", rotor_sigma_radps);
+  check(positive(huber), "huber", "must be > 0, got {}", huber);
+  check(positive(sigma_position_rate), "sigma_position_rate", "must be > 0, got {}", sigma_position_rate);
+  check(positive(sigma_acceleration), "sigma_acceleration", "must be > 0, got {}", sigma_acceleration);
+  check(positive(sigma_angular_acceleration), "sigma_angular_acceleration", "must be > 0, got {}",
+        sigma_angular_acceleration);
+  check(positive(sigma_rotation_rate), "sigma_rotation_rate", "must be > 0, got {}", sigma_rotation_rate);
+  check(positive(sigma_rotor_rate), "sigma_rotor_rate", "must be > 0, got {}", sigma_rotor_rate);
+  check(positive(baseline_window_s), "baseline_window_s", "must be > 0, got {}", baseline_window_s);
+  check(score_margin_s >= 0 && std::isfinite(score_margin_s), "score_margin_s", "must be >= 0, got {}", score_margin_s);
+  check(positive(function_tolerance), "function_tolerance", "must be > 0, got {}", function_tolerance);
+  check(max_iterations >= 1, "max_iterations", "must be >= 1, got {}", max_iterations);
+  check(threads >= 1, "threads", "must be >= 1, got {}", threads);
+}
+
+RotorEstimate EstimateRotors(const RotorFlight& flight, const RotorVehicle& vehicle, const RotorEstimateOptions& o) {
+  o.Validate();
+  RotorEstimate out;
+  const std::vector<std::pair<size_t, size_t>> spans = Spans(flight, o.score_margin_s);
+  const RotorModel model{vehicle.nominal, vehicle.theta};
+  const ceres::HuberLoss huber(o.huber);
+  std::vector<Eigen::Vector4d> estimate(flight.samples.size(), Eigen::Vector4d::Zero());
+  const auto start = Clock::now();
+  out.converged = true;
+  for (const auto& [first, last] : spans) {
+    std::unique_ptr<Problem> problem = BuildProblem(flight, first, last, model, o, false, &huber);
+    problem->AddCollocation(CollocationSigma(o));
+    problem->AddControlSmoothnessPrior(1, o.sigma_rotor_rate);
+    const ceres::Solver::Summary summary = problem->Solve(SolverOptions(o));
+    out.converged = out.converged && summary.termination_type == ceres::CONVERGENCE;
+    out.iterations += static_cast<int>(summary.iterations.size()) - 1;
+    out.states += problem->num_nodes();
+    out.segments += problem->num_segments();
+    out.duration_s += flight.samples[last].t - flight.samples[first].t;
+    for (size_t i = first; i <= last; ++i) {
+      const StateSample x = problem->Interpolate(flight.samples[i].t);
+      estimate[i] = x.control.head<4>();
+      RotorStateEstimate e;
+      e.t = flight.samples[i].t;
+      e.p = x.vector.segment<3>(0);
+      e.v = x.vector.segment<3>(3);
+      e.w = x.vector.segment<3>(6);
+      e.q = Eigen::Quaterniond(x.rotation);
+      e.rotor = estimate[i];
+      e.measured = flight.samples[i].rotor;
+      out.samples.push_back(e);
+    }
+  }
+  out.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const std::vector<Eigen::Vector4d> baseline =
+      FlatnessRotorSpeeds(flight, vehicle.nominal, RotorNominal::PublishedTheta(), o.baseline_window_s);
+  const std::vector<size_t> scored = ScoredSamples(flight, o.score_margin_s);
+  out.scored_samples = static_cast<int>(scored.size());
+  out.error = ScoreRotors(flight, estimate, scored);
+  out.baseline = ScoreRotors(flight, baseline, scored);
+  size_t k = 0;
+  for (const auto& [first, last] : spans) {
+    for (size_t i = first; i <= last; ++i, ++k) {
+      out.samples[k].baseline = baseline[i];
+      out.samples[k].scored = std::binary_search(scored.begin(), scored.end(), i);
+    }
+  }
+  return out;
+}
+
+namespace {
+
+// θ from one flight: the trajectory, its rotor speeds and θ jointly, the rotor speeds measured.
+RotorIdentification IdentifyOne(const RotorFlight& flight, const RotorVehicle& base, const RotorEstimateOptions& o) {
+  const auto start = Clock::now();
+  const RotorModel model{base.nominal, base.theta};
+  const ceres::HuberLoss huber(o.huber);
+  RotorThetaVector theta = base.theta;
+  std::vector<std::unique_ptr<Problem>> problems;
+  // One problem per span, all sharing θ: the spans' residuals go into the first problem's Ceres problem
+  // only when there is one span; with several, each is solved in turn with θ carried over.
+  RotorIdentification id;
+  const Eigen::MatrixXd D = cheb::DifferentiationMatrix(o.degree);
+  const Eigen::Matrix<double, 12, 1> sigma = CollocationSigma(o);
+  double cost = 0;
+  int residuals = 0, parameters = 0;
+  for (const auto& [first, last] : Spans(flight, o.score_margin_s)) {
+    std::unique_ptr<Problem> problem = BuildProblem(flight, first, last, model, o, true, &huber);
+    for (int s = 0; s < problem->num_segments(); ++s) {
+      const internal::Segment segment = problem->SegmentOf(s);
+      for (int j = 0; j <= o.degree; ++j) {
+        problem->AddPrior(std::make_unique<internal::CollocationCost<RotorModel>>(model, segment, D, j, 0, sigma));
+        problem->AddPrior(std::make_unique<internal::CollocationCost<RotorModel>>(model, segment, D, j, 3, sigma));
+        problem->AddPrior(std::make_unique<internal::ParametricCollocationCost>(
+            base.nominal, segment, D, j, 1, o.sigma_acceleration, theta.data()));
+        problem->AddPrior(std::make_unique<internal::ParametricCollocationCost>(
+            base.nominal, segment, D, j, 2, o.sigma_angular_acceleration, theta.data()));
+      }
+    }
+    problem->AddPrior(std::make_unique<ThetaPrior>(theta.data(), RotorNominal::PublishedTheta(), PriorSigma()));
+    for (int i = 0; i < 3; ++i) {  // a rigid body's inertia is positive: at least 1 % of the published one
+      problem->ceres_problem().SetParameterLowerBound(theta.data(), kThetaInertiaX + i, 0.01);
+    }
+    for (size_t i = first; i <= last; ++i) {
+      const internal::TimeRow row = problem->RowAt(flight.samples[i].t);
+      problem->AddPrior(std::make_unique<RotorSpeedMeasurement>(problem->SegmentOf(row.segment), row.w,
+                                                                flight.samples[i].rotor, o.rotor_sigma_radps));
+    }
+    const ceres::Solver::Summary summary = problem->Solve(SolverOptions(o));
+    id.converged = summary.termination_type == ceres::CONVERGENCE;
+    cost += summary.final_cost;
+    residuals += summary.num_residuals_reduced;
+    parameters += summary.num_effective_parameters_reduced;
+    problems.push_back(std::move(problem));
+  }
+  // Covariance of θ in the last span's problem (the usual case: one span).
+  ceres::Covariance::Options copt;
+  copt.num_threads = o.threads;
+  ceres::Covariance covariance(copt);
+  const std::vector<std::pair<const double*, const double*>> blocks = {{theta.data(), theta.data()}};
+  if (!covariance.Compute(blocks, &problems.back()->ceres_problem())) {
+    throw ComputeError(fmt::format("{}: the covariance of the identified parameters could not be computed (the "
+                                   "problem is rank-deficient)",
+                                   flight.path));
+  }
+  covariance.GetCovarianceBlock(theta.data(), theta.data(), id.covariance.data());
+  id.reduced_chi2 = 2.0 * cost / std::max(1, residuals - parameters);
+  id.covariance *= std::max(1.0, id.reduced_chi2);
+  id.theta = theta;
+  id.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return id;
+}
+
+}  // namespace
+
+RotorVehicle IdentifyRotors(const std::vector<RotorFlight>& flights, const RotorVehicle& base,
+                            const RotorEstimateOptions& options, std::vector<RotorIdentification>* per_flight) {
+  options.Validate();
+  if (flights.empty()) throw UsageError("identification needs at least one flight");
+  using Matrix = Eigen::Matrix<double, kRotorThetaSize, kRotorThetaSize>;
+  Matrix information = Matrix::Zero();
+  RotorThetaVector eta = RotorThetaVector::Zero();
+  RotorVehicle out = base;
+  out.training.clear();
+  for (const RotorFlight& flight : flights) {
+    const RotorIdentification id = IdentifyOne(flight, base, options);
+    const Matrix lambda = id.covariance.ldlt().solve(Matrix::Identity());
+    information += lambda;
+    eta += lambda * id.theta;
+    out.training.push_back(flight.path);
+    if (per_flight) per_flight->push_back(id);
+  }
+  const Matrix combined = information.ldlt().solve(Matrix::Identity());
+  out.theta = combined * eta;
+  out.theta_sigma = combined.diagonal().cwiseSqrt();
+  return out;
+}
+
+}  // namespace cheval::estim
