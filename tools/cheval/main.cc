@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
   cheval::cli::RegisterSimQuadrotor(app, &action);
   cheval::cli::RegisterEstimate(app, &action);
   cheval::cli::RegisterEstimateThrust(app, &action);
+  cheval::cli::RegisterTable(app, &action);
   cheval::cli::CheckNumericOptions(&app);
 
   auto fail = [](ExitCode code, const std::string& message) {
