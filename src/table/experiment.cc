@@ -11,6 +11,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "cheval/common/error.h"
+#include "cheval/eval/align.h"
 
 namespace cheval::table {
 namespace fs = std::filesystem;
@@ -219,6 +220,16 @@ Experiment ReadExperimentConfig(const std::string& path) {
   int frames = -1;
   if (root["align"]) align = As<std::string>(path, root["align"], "align", "an alignment name");
   if (root["align_frames"]) frames = As<int>(path, root["align_frames"], "align_frames", "an integer (-1: all)");
+  if (root["align"]) {
+    const bool rpg_name = align == "posyaw" || align == "sim3" || align == "se3" || align == "none";
+    if (mode == TableMode::kRpg ? !rpg_name : !eval::AlignmentMethodFromString(align)) {
+      Bad(path, root["align"], fmt::format("'align' must be {}, got '{}'",
+                                           mode == TableMode::kRpg ? "posyaw, sim3, se3 or none"
+                                                                   : "none, origin, se3, sim3, scale, posyaw or full",
+                                           align));
+    }
+  }
+  if (frames == 0 || frames < -1) Bad(path, root["align_frames"], "'align_frames' must be -1 (all) or >= 1");
   if (root["align"] || root["align_frames"]) {
     for (RunSpec& run : e.runs) {
       run.align = align;

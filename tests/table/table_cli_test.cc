@@ -209,6 +209,11 @@ TEST_F(TableCliTest, BadInputExitCodes) {
   EXPECT_NE(run.err.find("bad.yaml:3"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("reference"), std::string::npos) << run.err;
   Simulate("A", 41, 1);
+  WriteFile("al.yaml", "align: yawonly\ndatasets:\n  a: {reference: A_ref.txt}\n"
+                       "algorithms:\n  - name: x\n    estimates: {a: A_est0.txt}\n");
+  run = Cheval(fmt::format("table {} -o {}", Path("al.yaml"), Path("t.md")));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("al.yaml:1"), std::string::npos) << run.err;
   WriteFile("m.yaml", "metrics: [ape_speed]\ndatasets:\n  a: {reference: A_ref.txt}\n"
                       "algorithms:\n  - name: x\n    estimates: {a: A_est0.txt}\n");
   run = Cheval(fmt::format("table {} -o {}", Path("m.yaml"), Path("t.md")));
