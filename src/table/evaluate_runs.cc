@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <numeric>
 #include <regex>
 #include <sstream>
 #include <thread>
@@ -235,12 +236,28 @@ std::vector<RunResult> EvaluateRuns(const Experiment& e, const EvaluateRunsOptio
     std::filesystem::create_directories(options.cache_folder, ec);
     if (ec) throw OutputError(fmt::format("{}: error: cannot write: {}", options.cache_folder, ec.message()));
   }
+  // Work order: round robin over the references, so that concurrent workers start on different
+  // sequences instead of waiting for the same reference read and velocity fit.
+  std::vector<size_t> order(total);
+  {
+    std::map<std::string, size_t> seen;  // reference -> runs scheduled so far
+    std::vector<std::pair<size_t, size_t>> rank(total);
+    std::map<std::string, size_t> first;
+    for (size_t i = 0; i < total; ++i) {
+      const std::string& ref = e.runs[i].reference;
+      first.emplace(ref, first.size());
+      rank[i] = {seen[ref]++, first[ref]};
+    }
+    std::iota(order.begin(), order.end(), size_t{0});
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return rank[a] < rank[b]; });
+  }
   std::atomic<size_t> next{0};
   std::mutex progress_mutex;
   size_t done = 0;
   std::exception_ptr first_error;
   auto work = [&] {
-    for (size_t i = next++; i < total; i = next++) {
+    for (size_t slot = next++; slot < total; slot = next++) {
+      const size_t i = order[slot];
       const RunSpec& run = e.runs[i];
       RunResult& r = results[i];
       try {

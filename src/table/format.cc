@@ -193,9 +193,9 @@ std::string TableJson(const Table& t) {
 
 std::string TableHtml(const Table& t, const std::string& title) {
   std::string out = fmt::format(
-      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{0}</title>\n<style>\n"
+      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<link rel=\"icon\" href=\"data:,\">\n<title>{0}</title>\n<style>\n"
       "body{{font-family:system-ui,sans-serif;margin:2em;color:#222}}table{{border-collapse:collapse;margin:1em 0}}"
-      "th,td{{padding:.3em .8em;border-bottom:1px solid #ccc;text-align:right}}th:first-child,td:first-child,"
+      "th,td{{padding:.3em .8em;border-bottom:1px solid #ccc;text-align:right}}td{{white-space:nowrap}}th:first-child,td:first-child,"
       "th:nth-child(2),td:nth-child(2){{text-align:left}}thead th{{border-bottom:2px solid #222}}td.best{{font-weight:"
       "bold}}.failed{{color:#b00}}code{{background:#f4f4f4;padding:0 .2em}}\n</style>\n</head>\n<body>\n<h1>{0}</h1>\n"
       "<p>Mean ± std over trials ({1} mode); bold: lowest mean on the dataset.</p>\n",
