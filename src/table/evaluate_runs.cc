@@ -92,14 +92,33 @@ std::string FileBytes(const std::string& path) {
   return s.str();
 }
 
+// Hashes of the references' contents, each file read once.
+class ReferenceHashes {
+ public:
+  uint64_t Get(const std::string& path) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (auto it = hashes_.find(path); it != hashes_.end()) return it->second;
+    }
+    const uint64_t h = Fnv1a(FileBytes(path));
+    std::lock_guard<std::mutex> lock(mutex_);
+    hashes_[path] = h;
+    return h;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::map<std::string, uint64_t> hashes_;
+};
+
 // The cache key of a run: the two files' contents and everything that changes its numbers.
-std::string CacheKey(const Experiment& e, const RunSpec& run) {
+std::string CacheKey(const Experiment& e, const RunSpec& run, ReferenceHashes& hashes) {
   std::string options = fmt::format("cheval-table 1\nmode {}\nstatistic {}\nmax_diff {}\nalign {} {}\nrpg {} {} {} {}\n",
                                     e.mode == TableMode::kRpg ? "rpg" : "cheval", e.statistic, e.max_diff_s, run.align,
                                     run.align_frames, run.rpg.align_type, run.rpg.align_num_frames,
                                     run.rpg.start_time_s, run.rpg.end_time_s);
   for (const std::string& m : e.metrics) options += m + "\n";
-  const uint64_t a = Fnv1a(FileBytes(run.reference), Fnv1a(options));
+  const uint64_t a = Fnv1a(fmt::format("{:016x}", hashes.Get(run.reference)), Fnv1a(options));
   const uint64_t b = Fnv1a(FileBytes(run.estimate), a);
   return fmt::format("{:016x}{:016x}", a, b);
 }
@@ -231,6 +250,7 @@ std::vector<RunResult> EvaluateRuns(const Experiment& e, const EvaluateRunsOptio
   const size_t total = e.runs.size();
   std::vector<RunResult> results(total);
   ReferenceCache refs(e.mode);
+  ReferenceHashes hashes;
   if (!options.cache_folder.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(options.cache_folder, ec);
@@ -270,7 +290,7 @@ std::vector<RunResult> EvaluateRuns(const Experiment& e, const EvaluateRunsOptio
           bool cached = false;
           if (!options.cache_folder.empty()) {
             try {
-              cache_file = (std::filesystem::path(options.cache_folder) / (CacheKey(e, run) + ".json")).string();
+              cache_file = (std::filesystem::path(options.cache_folder) / (CacheKey(e, run, hashes) + ".json")).string();
             } catch (const InputError&) {
               cache_file.clear();  // unreadable input: EvaluateRun reports it
             }

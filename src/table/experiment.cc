@@ -142,7 +142,7 @@ Experiment ReadRpgLayout(const std::string& root, TableMode mode) {
     const FolderTrials trials = ListTrials(folder);
     base.algorithm = alg;
     AddTrials(&e, trials.traj, base);
-    base.algorithm = alg + "/ba";
+    base.algorithm = trials.traj.empty() ? alg : alg + "/ba";  // "/ba" only beside real-time estimates
     AddTrials(&e, trials.ba, base);
   }
   if (e.runs.empty()) {

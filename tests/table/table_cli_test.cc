@@ -155,12 +155,14 @@ TEST_F(TableCliTest, RpgLayoutCountsMissingTrials) {
               0);
   }
   ASSERT_EQ(Cheval(fmt::format("convert {} -o {} --to tum", Path("A_est1.txt"), (b / "stamped_traj_estimate.txt").string())).exit_code, 0);
+  // Bundle-adjusted estimates beside real-time ones are the algorithm "<alg>/ba".
+  fs::copy_file(b / "stamped_traj_estimate.txt", b / "stamped_ba_estimate0.txt");
   std::ofstream(a / "eval_cfg.yaml") << "align_type: posyaw\nalign_num_frames: -1\n";
   std::ofstream(b / "eval_cfg.yaml") << "align_type: sim3\nalign_num_frames: -1\n";
   const RunResult run = Cheval(fmt::format("table {} -o {} -j 2", (dir_ / "exp").string(), Path("t.json")));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const json table = ReadJson(Path("t.json"));
-  bool seen_a = false, seen_b = false;
+  bool seen_a = false, seen_b = false, seen_ba = false;
   for (const json& row : table["rows"]) {
     EXPECT_EQ(row["dataset"], "MH_01");
     if (row["algorithm"] == "algA") {
@@ -174,6 +176,9 @@ TEST_F(TableCliTest, RpgLayoutCountsMissingTrials) {
         ASSERT_EQ(hand.exit_code, 0) << hand.err;
         EXPECT_EQ(row["trials"][2].get<double>(), ReadJson(Path("h.json"))["stats"]["rmse"].get<double>());
       }
+    } else if (row["algorithm"] == "algB/ba") {
+      seen_ba = true;
+      EXPECT_EQ(row["failed"], 0);
     } else {
       seen_b = true;
       EXPECT_EQ(row["algorithm"], "algB");
@@ -185,7 +190,7 @@ TEST_F(TableCliTest, RpgLayoutCountsMissingTrials) {
       }
     }
   }
-  EXPECT_TRUE(seen_a && seen_b);
+  EXPECT_TRUE(seen_a && seen_b && seen_ba);
   // rpg mode on the same folder gives its metric names and finite numbers for the present trials.
   const RunResult rpg = Cheval(fmt::format("table {} --rpg -o {} --latex {} --html {}", (dir_ / "exp").string(),
                                            Path("r.json"), Path("r.tex"), Path("r.html")));

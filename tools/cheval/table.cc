@@ -58,7 +58,11 @@ void Run(const TableFlags& flags) {
                             : table::ReadExperimentConfig(flags.experiment);
   if (flags.rpg && e.mode != table::TableMode::kRpg) {
     e.mode = table::TableMode::kRpg;
-    if (!is_folder) e.metrics = table::DefaultMetrics(e.mode);
+    try {
+      table::CheckMetrics(e);
+    } catch (const UsageError&) {
+      e.metrics = table::DefaultMetrics(e.mode);  // the file's metrics are cheval-mode names
+    }
   }
   if (is_folder) e.metrics = table::DefaultMetrics(e.mode);
   if (!flags.metrics.empty()) {

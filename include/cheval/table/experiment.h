@@ -58,7 +58,8 @@ bool IsRpgLayout(const std::string& path);
 
 /// Discovers the runs of rpg's layout under `root` (see docs/table.md): per run folder the trials
 /// `stamped_traj_estimate.txt` or `stamped_traj_estimate{N}.txt` (algorithm `<alg>`) and
-/// `stamped_ba_estimate{N}.txt` (algorithm `<alg>/ba`); a missing number below the largest is a
+/// `stamped_ba_estimate{N}.txt` (algorithm `<alg>`, or `<alg>/ba` in a folder that also holds
+/// `stamped_traj_estimate*`); a missing number below the largest is a
 /// failed trial. The reference is the folder's `stamped_groundtruth.txt`, else that of another
 /// algorithm's folder of the same platform and dataset. The alignment is read from eval_cfg.yaml.
 /// InputError when nothing is found.
