@@ -71,6 +71,8 @@ void RegisterSimQuadrotor(CLI::App& app, Action* action);
 void RegisterEstimate(CLI::App& app, Action* action);
 /// `cheval estimate thrust` (needs RegisterEstimate first; tools/cheval/estimate_thrust.cc).
 void RegisterEstimateThrust(CLI::App& app, Action* action);
+/// `cheval table EXPERIMENT -o table.md` (tools/cheval/table.cc).
+void RegisterTable(CLI::App& app, Action* action);
 
 }  // namespace cheval::cli
 namespace cheval::cli {
