@@ -34,6 +34,9 @@ Container DetectContainer(const std::string& path) {
     return std::filesystem::is_regular_file(std::filesystem::path(path) / "metadata.yaml", error) ? Container::kRos2
                                                                                                    : Container::kNone;
   }
+  // Only a regular file can be a recording (the readers seek). A FIFO, a device or standard input is
+  // never opened here: a second open by the trajectory reader would find its writer gone.
+  if (!std::filesystem::is_regular_file(path, error)) return Container::kNone;
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (file == nullptr) return Container::kNone;
   char head[13] = {};

@@ -1,6 +1,8 @@
 // Recordings written by bag::WriteBag in every container, compression and encoding read back by
 // bag::ReadBagTrajectory / traj::ReadTrajectory: every message type, stamps from headers and from the
 // record time, Odometry twists turned into world-frame velocities, the last Path, tf chains.
+#include <sys/stat.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -254,6 +256,16 @@ TEST(Ros2Folder, OfMcapFilesReadsEveryFile) {
   const std::vector<TopicInfo> topics = ListTopics(folder);
   ASSERT_EQ(topics.size(), 1u);
   EXPECT_EQ(topics[0].count, 30);
+}
+
+// A FIFO is never a recording and is never opened to look: the trajectory reader opens it once
+// after (a first open would take the writer's data and leave the second waiting for a writer that is
+// gone; opening one without a writer here would block this test).
+TEST(DetectContainer, AFifoIsNotOpened) {
+  TempDir dir;
+  const std::string fifo = dir / "fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(DetectContainer(fifo), Container::kNone);
 }
 
 }  // namespace
