@@ -332,6 +332,8 @@
       ['degrees', `${Math.min(...degrees)} .. ${Math.max(...degrees)}`],
       ['noise σ (estimated)', f.noise_sigma.map((s) => s.toExponential(2) + ' m').join(', ')],
       ['fit residual RMS', f.residual_rms.map((s) => s.toExponential(2) + ' m').join(', ')],
+      ['residual test', f.unresolved_windows === 0 ? 'every window passed'
+        : `${f.unresolved_windows} window(s) failed at the smallest size; ${f.local_samples} samples followed by the local interpolant`],
     ]);
     const details = document.getElementById('fit-section');
     let drawn = false;
@@ -344,6 +346,15 @@
       lineChart(chartBox(row, 'fit-degrees', 'Chosen degree per window (at the window core’s centre)'), {
         xLabel: timeLabel, yLabel: 'degree', lines: axes.map((a, c) => ({ label: a, color: palette[c], x: centre, y: f.windows.map((w) => w.degrees[c]), points: true })),
       });
+      // Residual against the noise per window: a fit that resolved the motion leaves about σ.
+      const tested = f.windows.filter((w) => w.residual_rms);
+      if (tested.length > 0) {
+        const at = tested.map((w) => (w.core_begin + w.core_end) / 2);
+        const positive = (v) => (v > 0 ? v : null);
+        const lines = axes.map((a, c) => ({ label: 'residual RMS ' + a, color: palette[c], x: at, y: tested.map((w) => positive(w.residual_rms[c])), points: true, width: 1 }));
+        axes.forEach((a, c) => lines.push({ label: 'noise σ ' + a, color: palette[c], dash: [5, 4], width: 1, x: at, y: at.map(() => positive(f.noise_sigma[c])) }));
+        lineChart(chartBox(row, 'fit-residual', 'Residual RMS per window against the noise σ'), { xLabel: timeLabel, yLabel: 'm', lines, log: true });
+      }
       const target = chartBox(row, 'fit-coefficients', 'Coefficient decay |c_k| in one window');
       const controls = el('div', { class: 'controls' });
       const slider = el('input', { type: 'range', min: '0', max: String(f.coefficients.length - 1), value: '0', step: '1', 'aria-label': 'window' });

@@ -3,6 +3,7 @@
 #include "conditioning.h"
 #include "end_caps.h"
 #include "jumps.h"
+#include "local_rates.h"
 
 #include <algorithm>
 #include <array>
@@ -704,13 +705,13 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     curve.segments_.push_back(std::move(segment));
   }
 
-  if (options.end_caps && !options.single_window && !options.window_s &&
-      options.degree_method != DegreeMethod::kFixed) {
-    std::vector<int64_t> sorted;
-    sorted.reserve(static_cast<size_t>(fitted_count));
-    for (Eigen::Index i = 0; i < m; ++i) {
-      if (kept[static_cast<size_t>(i)]) sorted.push_back(stamps_ns[order[i]]);
-    }
+  const bool adaptive = !options.single_window && !options.window_s && options.degree_method != DegreeMethod::kFixed;
+  std::vector<int64_t> sorted;  // the fitted samples' stamps
+  sorted.reserve(static_cast<size_t>(fitted_count));
+  for (Eigen::Index i = 0; i < m; ++i) {
+    if (kept[static_cast<size_t>(i)]) sorted.push_back(stamps_ns[order[i]]);
+  }
+  if (options.end_caps && adaptive) {
     // A segment's caps are chosen before they are inserted, and evaluating one segment's samples
     // uses only its own windows.
     const internal::VelocityAt velocity = [&](Eigen::Index first, Eigen::Index count) {
@@ -721,6 +722,21 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     };
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
       internal::AddEndCaps(t, z, velocity, starts[k], starts[k + 1], &curve.segments_[k]);
+    }
+  }
+
+  // Where windows clearly missed motion, the samples' own local interpolant (docs/velocity.md).
+  if (options.lack_of_fit && adaptive && curve.unresolved_windows() > 0) {
+    Eigen::MatrixXd fit_values, fit_rates;
+    curve.EvaluateMany(sorted, 1, &fit_values, &fit_rates);
+    for (Eigen::Index i = 0; i < fitted_count; ++i) {  // the fitted values without the steps, as z
+      const auto k = std::upper_bound(curve.step_times_.begin(), curve.step_times_.end(), t[i]) - curve.step_times_.begin();
+      if (k > 0) fit_values.row(i) -= curve.step_offsets_.row(k - 1);
+    }
+    for (size_t k = 0; k + 1 < starts.size(); ++k) {
+      std::vector<LocalRun> runs = internal::LocalRuns(t, z, starts[k], starts[k + 1], curve.segments_[k], fit_values,
+                                                       fit_rates, curve.noise_sigma_, kLackOfFitLimit);
+      std::move(runs.begin(), runs.end(), std::back_inserter(curve.local_runs_));
     }
   }
 
@@ -800,6 +816,33 @@ Curve::Placement Curve::Locate(double t, double tolerance_s) const {
   return placement;
 }
 
+const LocalRun* Curve::LocalRunAt(double t) const {
+  if (local_runs_.empty()) return nullptr;
+  const auto it = std::upper_bound(local_runs_.begin(), local_runs_.end(), t,
+                                   [](double time, const LocalRun& run) { return time < run.times.front(); });
+  if (it == local_runs_.begin()) return nullptr;
+  const LocalRun& run = *(it - 1);
+  return t <= run.times.back() ? &run : nullptr;
+}
+
+namespace {
+
+// The cubic Hermite interpolant of a local run at t (inside it): value, first and second derivative.
+template <typename P, typename V, typename A>
+void EvaluateLocal(const LocalRun& run, double t, int order, P&& p, V&& v, A&& a) {
+  auto k = static_cast<Eigen::Index>(std::upper_bound(run.times.begin(), run.times.end(), t) - run.times.begin()) - 1;
+  k = std::clamp<Eigen::Index>(k, 0, static_cast<Eigen::Index>(run.times.size()) - 2);
+  const double t0 = run.times[static_cast<size_t>(k)], h = run.times[static_cast<size_t>(k) + 1] - t0;
+  const double u = (t - t0) / h, u2 = u * u, u3 = u2 * u;
+  const auto z0 = run.values.row(k), z1 = run.values.row(k + 1);
+  const auto v0 = run.rates.row(k) * h, v1 = run.rates.row(k + 1) * h;
+  p = (2 * u3 - 3 * u2 + 1) * z0 + (u3 - 2 * u2 + u) * v0 + (3 * u2 - 2 * u3) * z1 + (u3 - u2) * v1;
+  if (order >= 1) v = ((6 * u2 - 6 * u) * z0 + (3 * u2 - 4 * u + 1) * v0 + (6 * u - 6 * u2) * z1 + (3 * u2 - 2 * u) * v1) / h;
+  if (order >= 2) a = ((12 * u - 6) * z0 + (6 * u - 4) * v0 + (6 - 12 * u) * z1 + (6 * u - 2) * v1) / (h * h);
+}
+
+}  // namespace
+
 void Curve::EvaluateUpTo(int64_t stamp_ns, int order, Eigen::Ref<Eigen::VectorXd> value,
                          Eigen::Ref<Eigen::VectorXd>* derivative, Eigen::Ref<Eigen::VectorXd>* second_derivative,
                          double tolerance_s) const {
@@ -815,6 +858,11 @@ void Curve::EvaluateUpTo(int64_t stamp_ns, int order, Eigen::Ref<Eigen::VectorXd
     if (order >= 2) a = (1.0 - s) * a + s * ar + 2.0 * ds * (vr - v) + dds * (pr - p);
     if (order >= 1) v = (1.0 - s) * v + s * vr + ds * (pr - p);
     p = (1.0 - s) * p + s * pr;
+  }
+  if (const LocalRun* run = LocalRunAt(t)) {
+    Eigen::RowVectorXd lp(dimension_), lv(dimension_), la(dimension_);
+    EvaluateLocal(*run, t, order, lp, lv, la);
+    p = lp.transpose(), v = lv.transpose(), a = la.transpose();
   }
   value = p;
   AddSteps(t, value.transpose());
@@ -875,6 +923,15 @@ void Curve::EvaluateMany(std::span<const int64_t> stamps_ns, int order, Eigen::M
   for (Eigen::Index r = 0; r < n; ++r) {
     const Placement& q = placements[r];
     const Eigen::Index i = sorted[r];
+    if (const LocalRun* run = LocalRunAt(t[r])) {
+      Eigen::RowVectorXd p(d), v(d), a(d);
+      EvaluateLocal(*run, t[r], order, p, v, a);
+      values->row(i) = p;
+      AddSteps(t[r], values->row(i));
+      if (order >= 1) first->row(i) = v;
+      if (order >= 2) second->row(i) = a;
+      continue;
+    }
     if (q.right == nullptr) {
       values->row(i) = left[0].row(r);
       AddSteps(t[r], values->row(i));
@@ -933,8 +990,23 @@ Eigen::Index Curve::unresolved_windows() const {
   return count;
 }
 
+std::string_view ToString(WindowVerdict verdict) {
+  switch (verdict) {
+    case WindowVerdict::kResolved: return "resolved";
+    case WindowVerdict::kUnresolved: return "unresolved";
+    case WindowVerdict::kFixedDegree: return "fixed_degree";
+  }
+  return "unknown";
+}
+
+Eigen::Index Curve::local_samples() const {
+  Eigen::Index count = 0;
+  for (const LocalRun& run : local_runs_) count += static_cast<Eigen::Index>(run.times.size());
+  return count;
+}
+
 Eigen::Index Curve::stored_values() const {
-  Eigen::Index total = 0;
+  Eigen::Index total = (2 * dimension_ + 1) * local_samples();  // a time, values and rates
   for (const CurveSegment& s : segments_) {
     for (const CurveWindow& w : s.windows) {
       for (int degree : w.degrees) total += degree + 1;

@@ -252,19 +252,6 @@ traj::Trajectory VelocityTrajectory(const traj::TrajectoryView& input, const Vel
   return out;
 }
 
-namespace {
-
-const char* VerdictName(cheb::WindowVerdict verdict) {
-  switch (verdict) {
-    case cheb::WindowVerdict::kResolved: return "resolved";
-    case cheb::WindowVerdict::kUnresolved: return "unresolved";
-    case cheb::WindowVerdict::kFixedDegree: return "fixed_degree";
-  }
-  return "unknown";
-}
-
-}  // namespace
-
 std::string UnresolvedWarning(const cheb::Curve& curve) {
   const cheb::CurveWindow* worst = nullptr;
   double worst_ratio = 0.0;
@@ -278,10 +265,14 @@ std::string UnresolvedWarning(const cheb::Curve& curve) {
     }
   }
   if (worst == nullptr) return {};
-  return fmt::format(
+  const std::string where = fmt::format(
       "{} window(s) still fail the residual test at the smallest window; the worst, {:.3f}..{:.3f} s from the first "
-      "sample, has a residual {:.1f}x the noise: its velocity may miss motion there (--json lists them)",
+      "sample, has a residual {:.1f}x the noise",
       curve.unresolved_windows(), worst->fit_begin, worst->fit_end, worst_ratio);
+  if (curve.local_samples() == 0) return where + ": its velocity may miss motion there (--json lists them)";
+  return fmt::format("{}: where the residual is clearly above the noise the velocity comes from the samples' local "
+                     "interpolant ({} samples; --json lists the windows)",
+                     where, curve.local_samples());
 }
 
 std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimate) {
@@ -297,7 +288,7 @@ std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimat
     for (const cheb::CurveSegment& segment : curve.segments()) {
       for (const cheb::CurveWindow& w : segment.windows) {
         nlohmann::json window = {{"begin_s", w.fit_begin}, {"end_s", w.fit_end}, {"samples", w.samples},
-                                 {"degrees", w.degrees}, {"accepted", VerdictName(w.verdict)}};
+                                 {"degrees", w.degrees}, {"accepted", std::string(cheb::ToString(w.verdict))}};
         if (w.residual_rms.size() == curve.dimension()) {  // end caps are chosen otherwise (docs/velocity.md)
           window["residual_rms_m"] = std::vector<double>(w.residual_rms.data(), w.residual_rms.data() + w.residual_rms.size());
           window["lack_of_fit"] = std::vector<double>(w.lack_of_fit.data(), w.lack_of_fit.data() + w.lack_of_fit.size());
@@ -315,6 +306,7 @@ std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimat
     j["residual_rmse_m"] = std::vector<double>(curve.residual_rms().data(), curve.residual_rms().data() + 3);
     j["compression_ratio"] = static_cast<double>(3 * run.input_poses) / static_cast<double>(curve.stored_values());
     j["unresolved_windows"] = curve.unresolved_windows();
+    j["local_samples"] = curve.local_samples();
     j["outliers"] = curve.outlier_times().size();
     j["jumps"] = curve.jump_times().size();
     j["steps"] = curve.step_times().size();

@@ -93,7 +93,13 @@ Json FitDiagnostics(const cheb::Curve& curve, const Clock& clock, std::size_t ma
                          {"core_begin", Rounded(w.core_begin + shift, 9)},
                          {"core_end", Rounded(w.core_end + shift, 9)},
                          {"samples", w.samples},
-                         {"degrees", w.degrees}});
+                         {"degrees", w.degrees},
+                         {"verdict", std::string(cheb::ToString(w.verdict))}});
+      if (w.residual_rms.size() == curve.dimension()) {  // end caps are chosen otherwise (docs/velocity.md)
+        Json residual = Json::array();
+        for (Eigen::Index c = 0; c < w.residual_rms.size(); ++c) residual.push_back(Rounded(w.residual_rms[c], 4));
+        windows.back()["residual_rms"] = residual;
+      }
       all.push_back(&w);
     }
   }
@@ -124,7 +130,9 @@ Json FitDiagnostics(const cheb::Curve& curve, const Clock& clock, std::size_t ma
               {"windows", windows},
               {"coefficients", coefficients},
               {"noise_sigma", std::vector<double>(sigma.data(), sigma.data() + sigma.size())},
-              {"residual_rms", std::vector<double>(residual.data(), residual.data() + residual.size())}};
+              {"residual_rms", std::vector<double>(residual.data(), residual.data() + residual.size())},
+              {"unresolved_windows", curve.unresolved_windows()},
+              {"local_samples", curve.local_samples()}};
 }
 
 // The reference's velocity three ways and its Chebyshev fit; what cannot be computed is a note.

@@ -169,8 +169,8 @@ async function main() {
     check(await tab.$eval('#fit-section', (d) => !d.open) && (await tab.$$('#chart-fit-degrees')).length === 0, 'the fit diagnostics are collapsed and not drawn');
     await tab.click('#fit-section summary');
     await tab.waitForSelector('#chart-fit-coefficients[data-points]');
-    const fitPoints = await tab.$$eval('#chart-fit-degrees, #chart-fit-coefficients', (b) => b.map((x) => Number(x.dataset.points)));
-    check(fitPoints.length === 2 && fitPoints.every((n) => n > 0), `opened, the fit charts are drawn (${fitPoints})`);
+    const fitPoints = await tab.$$eval('#chart-fit-degrees, #chart-fit-residual, #chart-fit-coefficients', (b) => b.map((x) => Number(x.dataset.points)));
+    check(fitPoints.length === 3 && fitPoints.every((n) => n > 0), `opened, the fit charts (degrees, residual against the noise, coefficients) are drawn (${fitPoints})`);
 
     // Every chart exports PNG, SVG and CSV; the files are what they say.
     const exportable = await tab.$$eval('.chart', (boxes) => boxes.every((b) => ['png', 'svg', 'csv'].every((k) => b.querySelector(`button[data-export="${k}"]`))));
@@ -197,7 +197,7 @@ async function main() {
       }
       return out;
     });
-    check(exports.length === expected.length + 2, `every chart exports (${exports.length} charts with the fit diagnostics)`);
+    check(exports.length === expected.length + 3, `every chart exports (${exports.length} charts with the fit diagnostics)`);
     for (const e of exports) {
       check(e.svg && e.csvLines >= 3 && e.png && e.pngBytes > 3000, `${e.id}: SVG with shapes (${e.svgBytes} B), CSV ${e.csvLines} lines x ${e.columns} columns, PNG ${e.pngBytes} B`);
     }

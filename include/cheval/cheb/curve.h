@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -77,7 +78,9 @@ struct CurveOptions {
   bool robust = true;
   /// A window is accepted only when its residual is consistent with the noise too (the
   /// lack-of-fit test, docs/velocity.md), not only its coefficients: otherwise it is split, down to
-  /// min_window_samples. false judges by the coefficients alone (compression does: on nearly
+  /// min_window_samples. Where a window still fails there and its residual is clearly above the
+  /// noise, the adaptive curve follows the samples with a local interpolant (LocalRun). false
+  /// judges by the coefficients alone (compression does: on nearly
   /// noise-free ground truth the residual test asks for windows that store more than the samples).
   bool lack_of_fit = true;
   /// Told "fitting windows" with the samples fitted so far, as windows are accepted (may be empty).
@@ -101,6 +104,9 @@ enum class WindowVerdict {
   /// A fixed degree was asked for: nothing was tested for acceptance.
   kFixedDegree,
 };
+
+/// "resolved", "unresolved" or "fixed_degree" (the JSON and the report name verdicts so).
+std::string_view ToString(WindowVerdict verdict);
 
 /// One window: its core [core_begin, core_end] (seconds from the curve's origin), the samples used
 /// and the fit, with a degree per coordinate (coefficients of lower-degree coordinates are padded
@@ -131,6 +137,16 @@ struct CurveSegment {
   /// The next segment follows without a gap: the data were split at a jump (CurveOptions::robust),
   /// and a time between the two segments belongs to the nearer one.
   bool continues = false;
+};
+
+/// Where the fit could not resolve the motion, the samples themselves: a cubic Hermite interpolant
+/// through their values with the local rates of docs/velocity.md ("Local interpolant"). The first
+/// and last sample carry the windows' own value and derivative unless they are a segment's end
+/// (the curve stays C¹ where it passes from the fit to the samples).
+struct LocalRun {
+  std::vector<double> times;  ///< s from the curve's origin, increasing
+  Eigen::MatrixXd values;     ///< (k x d), the curve's values without its steps
+  Eigen::MatrixXd rates;      ///< (k x d), per second
 };
 
 /// The fitted curve.
@@ -179,6 +195,11 @@ class Curve {
   const std::vector<double>& step_times() const { return step_times_; }
   /// The windows that were accepted unresolved (WindowVerdict::kUnresolved).
   Eigen::Index unresolved_windows() const;
+  /// Where the curve follows the samples instead of the windows (CurveOptions::lack_of_fit), in
+  /// time order; empty when every window resolved the motion.
+  const std::vector<LocalRun>& local_runs() const { return local_runs_; }
+  /// The samples in local_runs (each run's ends included).
+  Eigen::Index local_samples() const;
 
  private:
   // Where a time falls: its window, and when it is in a blending zone the next window with the
@@ -204,6 +225,9 @@ class Curve {
   // Adds the steps before time t to a value.
   template <typename Row>
   void AddSteps(double t, Row&& value) const;
+  std::vector<LocalRun> local_runs_;
+  // The local run holding time t, or nullptr.
+  const LocalRun* LocalRunAt(double t) const;
 };
 
 /// Quintic smoothstep s(u) = 6u⁵ − 15u⁴ + 10u³ on u clamped to [0, 1], with ds/du and d²s/du²:
