@@ -485,19 +485,48 @@ void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegme
           samples_in(end.core_begin, end.core_end) < 2 * std::max<Eigen::Index>(options.min_window_samples, kMinEndWindowSamples)) {
         break;
       }
-      const double a = end.core_begin, b = end.core_end, middle = 0.5 * (a + b);
+      // Halving one step at a time fits every outer half on the way and drops all but the last.
+      // A resolved motion needs a degree about proportional to the window's length, so the cuts
+      // the halvings are expected to make are taken at once (each halved piece holding enough
+      // samples), and the end piece is checked from there back outwards: while the next larger
+      // piece would already have stopped the halving (degree at most end_degree), it is the end
+      // piece. The windows are those the one-by-one halving leaves (its degrees fall as its length
+      // does), for two fits of the end piece instead of one per halving. Cross-validated degrees
+      // follow the length; standardChop's jump to the noise plateau and do not, so with it the
+      // end window is halved one step at a time.
+      const double a = end.core_begin, b = end.core_end;
+      const Eigen::Index minimum = 2 * std::max<Eigen::Index>(options.min_window_samples, kMinEndWindowSamples);
+      const bool predict = options.degree_method == DegreeMethod::kCrossValidation;
+      std::vector<double> cuts{front ? b : a};  // from the inside out
+      for (double degree = max_degree(end); degree > options.end_degree && (predict || cuts.size() < 2); degree *= 0.5) {
+        if (cuts.size() > 1 && (front ? samples_in(a, cuts.back()) : samples_in(cuts.back(), b)) < minimum) break;
+        cuts.push_back(front ? 0.5 * (a + cuts.back()) : 0.5 * (cuts.back() + b));
+      }
+      auto fit_end = [&](double cut) {
+        return front ? *fitter.Fit(a, cut, segment.begin, segment.end, false)
+                     : *fitter.Fit(cut, b, segment.begin, segment.end, false);
+      };
+      CurveWindow outer = fit_end(cuts.back());
+      while (cuts.size() > 2 && max_degree(outer) <= options.end_degree) {
+        CurveWindow larger = fit_end(cuts[cuts.size() - 2]);
+        if (max_degree(larger) > options.end_degree) break;
+        cuts.pop_back();
+        outer = std::move(larger);
+      }
+      std::vector<CurveWindow> refined;
+      auto append = [&refined](std::vector<CurveWindow> more) {
+        refined.insert(refined.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
+      };
       if (front) {
-        CurveWindow outer = *fitter.Fit(a, middle, segment.begin, segment.end, false);
-        std::vector<CurveWindow> inner = FitAdaptive(fitter, t, segment, middle, b, options);
+        refined.push_back(std::move(outer));
+        for (size_t k = cuts.size() - 1; k >= 1; --k) append(FitAdaptive(fitter, t, segment, cuts[k], cuts[k - 1], options));
         windows.erase(windows.begin());
-        windows.insert(windows.begin(), std::make_move_iterator(inner.begin()), std::make_move_iterator(inner.end()));
-        windows.insert(windows.begin(), std::move(outer));
+        windows.insert(windows.begin(), std::make_move_iterator(refined.begin()), std::make_move_iterator(refined.end()));
       } else {
-        std::vector<CurveWindow> inner = FitAdaptive(fitter, t, segment, a, middle, options);
-        CurveWindow outer = *fitter.Fit(middle, b, segment.begin, segment.end, false);
+        for (size_t k = 1; k < cuts.size(); ++k) append(FitAdaptive(fitter, t, segment, cuts[k - 1], cuts[k], options));
+        refined.push_back(std::move(outer));
         windows.pop_back();
-        windows.insert(windows.end(), std::make_move_iterator(inner.begin()), std::make_move_iterator(inner.end()));
-        windows.push_back(std::move(outer));
+        windows.insert(windows.end(), std::make_move_iterator(refined.begin()), std::make_move_iterator(refined.end()));
       }
     }
   }
