@@ -129,6 +129,12 @@ std::vector<ZipMember> ReadZip(std::string_view bytes, const std::string& path, 
                              "truncated or damaged zip", name, compressed));
     }
     const std::string_view raw = bytes.substr(data_at, compressed);
+    // Deflate gives at most 1032 bytes per byte: a larger claim is a damaged (or hostile) header, refused
+    // before the output is allocated.
+    if (method == 8 && size > compressed * 1032 + 1024) {
+      Fail(path, fmt::format("member {}: claims {} bytes from {} deflated bytes, more than deflate can give", name,
+                             size, compressed));
+    }
     if (method == 0) {
       if (compressed != size) {
         Fail(path, fmt::format("member {}: stored with {} bytes, its header says {}", name, compressed, size));

@@ -17,6 +17,7 @@
 #include "cheval/eval/res_read.h"
 #include "cheval/eval/res_table.h"
 #include "../support/test_data.h"
+#include "../../fuzz/res_fuzz_checks.h"
 
 namespace cheval::eval {
 namespace {
@@ -188,6 +189,17 @@ TEST(ResRead, NpyDtypes) {
   EXPECT_THROW(ParseNpy(npy("<c16", "(1,)", false, std::string(16, '\0')), "p", "a"), InputError);
   EXPECT_THROW(ParseNpy(npy("<f8", "(99999999999,99999999999)", false, ""), "p", "a"), InputError);
   EXPECT_THROW(ParseNpy(npy("<f8", "(1,)", false, std::string(9, '\0')), "p", "a"), InputError);
+}
+
+// The kept inputs of fuzz_res (tests/data/fuzz/res, fuzz/make_res_seeds.sh and what runs found),
+// through exactly the checks the target runs (docs/fuzzing.md).
+TEST(ResRead, FuzzInputsKeepTheirProperties) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(CHEVAL_TEST_DATA_DIR) / "fuzz" / "res")) {
+    files.push_back(entry.path());
+  }
+  ASSERT_GE(files.size(), 9u);
+  for (const auto& file : files) EXPECT_EQ(fuzz::CheckResultFileInput(ReadBytes(file.string())), std::nullopt) << file;
 }
 
 }  // namespace
