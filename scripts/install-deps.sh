@@ -11,6 +11,7 @@ packages=(
   libsqlite3-dev libzstd-dev liblz4-dev libbz2-dev libyaml-cpp-dev  # recordings (src/bag)
   chromium chromium-driver  # the browser test of `cheval report` (tests/report/browser_test.js)
   python3-matplotlib  # cheval.plot, figures for papers (python/cheval/plot.py)
+  zlib1g-dev  # deflated members of result zips (src/common/zip.cc, cheval res)
 )
 
 # The report's chart library comes from the npm registry at build time: the machine's Node.js and npm

@@ -72,7 +72,7 @@ def _columns_text(columns):
     return columns if isinstance(columns, str) else ",".join(columns)
 
 
-def read(path, format="auto", columns=None, kitti_times=None, topic=None, bag_time=False):
+def read(path, format="auto", columns=None, kitti_times=None, topic=None, bag_time=False, quat_order="xyzw"):
     """Reads a trajectory file exactly as the CLI does (docs/formats.md) and returns a Trajectory.
 
     format: 'auto' (decided from the content), 'tum', 'tumv', 'euroc', 'kitti', 'vins' or 'csv';
@@ -80,10 +80,13 @@ def read(path, format="auto", columns=None, kitti_times=None, topic=None, bag_ti
     '_' skips a column); kitti_times: a file with one stamp (seconds) per KITTI pose.
     topic: for a recording (ROS 1 bag, ROS 2 bag folder, MCAP; docs/bags.md) the topic, or
     '/tf:PARENT.CHILD' for a tf chain; bag_time: stamps from the record time, not the headers.
+    quat_order: the order of the returned trajectory's ``quaternions`` array, 'xyzw' (cheval's and
+    TUM's) or 'wxyz' (evo's ``orientations_quat_wxyz``); the file's own order is set by its format.
     Raises InputError ('PATH:LINE:COLUMN: error: ...') for bad input, UsageError for bad arguments.
     """
     return _cheval.read(_path(path), format, _columns_text(columns),
-                        "" if kitti_times is None else _path(kitti_times, "kitti_times"), topic or "", bool(bag_time))
+                        "" if kitti_times is None else _path(kitti_times, "kitti_times"), topic or "", bool(bag_time),
+                        quat_order)
 
 
 def write(trajectory, path, format="tum"):
@@ -105,14 +108,18 @@ def write_model(model, path):
     _cheval.write_model(model, _path(path))
 
 
-def _trajectory(source, format="auto", columns=None, kitti_times=None):
-    """A Trajectory from a path, a Trajectory or a mapping of its constructor's arguments."""
+def _trajectory(source, format="auto", columns=None, kitti_times=None, quat_order=None):
+    """A Trajectory from a path, a Trajectory or a mapping of its constructor's arguments (quaternions in
+    quat_order, else the mapping's own 'quat_order', else x y z w; stamps int64 ns or float seconds)."""
     if isinstance(source, Trajectory):
         return source
     if isinstance(source, (str, _os.PathLike)):
-        return read(source, format, columns, kitti_times)
+        return read(source, format, columns, kitti_times, quat_order=quat_order or "xyzw")
     if isinstance(source, _Mapping):
-        return Trajectory(**source)
+        arrays = dict(source)
+        if quat_order is not None:
+            arrays["quat_order"] = quat_order
+        return Trajectory(**arrays)
     raise TypeError(f"expected a path, a cheval.Trajectory or a mapping of arrays, got {type(source).__name__}")
 
 
@@ -123,15 +130,18 @@ def _stamps(at):
 
 def _trajectory_to_dict(self):
     """The trajectory's arrays by the constructor's names (views, no copy); None for absent channels."""
-    return {"stamps": self.stamps, "positions": self.positions, "quaternions": self.quaternions,
-            "velocities": self.velocities, "angular_velocities": self.angular_velocities}
+    arrays = {"stamps": self.stamps, "positions": self.positions, "quaternions": self.quaternions,
+              "velocities": self.velocities, "angular_velocities": self.angular_velocities}
+    if self.quat_order != "xyzw":
+        arrays["quat_order"] = self.quat_order  # so that Trajectory(**t.to_dict()) reads them in that order
+    return arrays
 
 
 Trajectory.to_dict = _trajectory_to_dict
 
 
 def velocity(source, *, at=None, method="chebyshev", degree="auto", window=None, savgol_window=21,
-             angular=False, format="auto", columns=None, kitti_times=None):
+             angular=False, format="auto", columns=None, kitti_times=None, quat_order=None):
     """World-frame linear velocity from positions, as ``cheval velocity`` (docs/velocity.md).
 
     source: a path, Trajectory or mapping (positions are used; orientations with angular=True).
@@ -146,10 +156,16 @@ def velocity(source, *, at=None, method="chebyshev", degree="auto", window=None,
     (chebyshev; else None), 'angular_velocities' (n, 3) rad/s or None, 'orientations' (n, 4) x y z w
     fitted (chebyshev with angular) or None, 'curve' (the fitted Curve, chebyshev) or None,
     'angular_residual_rms' (rad) or None. No array is copied on the way out.
+    quat_order: 'xyzw' or 'wxyz', the order of a mapping's quaternions and of 'orientations' (default:
+    the source trajectory's quat_order; 'wxyz' copies 'orientations').
     """
-    trajectory = _trajectory(source, format, columns, kitti_times)
-    return _cheval.velocity(trajectory, at=None if at is None else _stamps(at), method=method,
-                            degree=degree, window=window, savgol_window=savgol_window, angular=angular)
+    trajectory = _trajectory(source, format, columns, kitti_times, quat_order)
+    out = _cheval.velocity(trajectory, at=None if at is None else _stamps(at), method=method,
+                           degree=degree, window=window, savgol_window=savgol_window, angular=angular)
+    if trajectory.quat_order == "wxyz" and out.get("orientations") is not None:
+        import numpy as _np
+        out["orientations"] = _np.roll(out["orientations"], 1, axis=1)
+    return out
 
 
 def fit(source, values=None, *, degree="auto", window=None, noise=None, format="auto", columns=None,
@@ -195,12 +211,12 @@ def _sides(ref, est, options):
         def get(name):
             value = options.get(prefix + name)
             return options.get(name) if value is None else value
-        return _trajectory(source, get("format") or "auto", get("columns"), get("kitti_times"))
+        return _trajectory(source, get("format") or "auto", get("columns"), get("kitti_times"), get("quat_order"))
     return side(ref, "ref_"), side(est, "est_")
 
 
 _INPUT_OPTIONS = {f"{prefix}{name}" for prefix in ("", "ref_", "est_")
-                  for name in ("format", "columns", "kitti_times")}
+                  for name in ("format", "columns", "kitti_times", "quat_order")}
 
 
 def _check_input_options(function, options):
@@ -224,7 +240,9 @@ def align(ref, est, *, method="se3", n_align=0, t_max_diff=_T_MAX_DIFF, t_offset
     """The alignment of the estimate onto the reference from the associated pairs, as ``--align``:
     method 'none', 'origin', 'se3', 'sim3', 'scale', 'posyaw' or 'full'; n_align: solve from the
     first N pairs (0: all). Returns {'method', 'rotation' (3, 3), 'translation' (3,), 'scale',
-    'pairs_used'}; an estimate state maps to R' = R R_i, p' = R (c p_i) + t, v' = c R v_i.
+    'pairs_used', 'trajectory'}; an estimate state maps to R' = R R_i, p' = R (c p_i) + t, v' = c R v_i,
+    and 'trajectory' is the whole estimate so mapped (a Trajectory, every pose, in the estimate's
+    quat_order; the keys before it are as they were before it was added).
     """
     _check_input_options("align", inputs)
     r, e = _sides(ref, est, inputs)

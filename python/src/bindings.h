@@ -29,7 +29,13 @@ struct PyTrajectory {
   traj::Trajectory trajectory;
   std::string path = "<array>";
   traj::Format format = traj::Format::kAuto;
+  /// The order of the quaternion arrays this object takes and gives (quat_order 'wxyz'); the library's
+  /// storage is always x y z w.
+  bool quat_wxyz = false;
 };
+
+/// quat_order's value: true for 'wxyz', false for 'xyzw'; UsageError naming the keyword otherwise.
+bool QuatOrderIsWxyz(const std::string& quat_order);
 
 /// A read-only numpy view of `data` (no copy) whose lifetime is tied to `owner` (the Python object
 /// that owns the memory). `shape` and `strides` (bytes) as numpy takes them.

@@ -8,6 +8,7 @@
 
 #include "bindings.h"
 #include "cheval/common/error.h"
+#include "cheval/eval/extrinsic.h"
 #include "cheval/eval/evaluate.h"
 
 namespace cheval::python {
@@ -107,6 +108,14 @@ py::dict Align(const PyTrajectory& ref, const PyTrajectory& est, const std::stri
   out["translation"] = Eigen::Vector3d(result.transform.translation);
   out["scale"] = result.transform.scale;
   out["pairs_used"] = result.pairs_used;
+  // The estimate with the alignment applied to every state, as ape/rpe/ase apply it (a left similarity).
+  eval::Extrinsic left;
+  left.rotation = Eigen::Matrix3d(result.transform.rotation);
+  left.translation = result.transform.translation;
+  left.scale = result.transform.scale;
+  PyTrajectory aligned{eval::TransformTrajectory(est.trajectory.View(), &left, nullptr), est.path, est.format,
+                       est.quat_wxyz};
+  out["trajectory"] = std::move(aligned);
   return out;
 }
 

@@ -1,6 +1,7 @@
 // The extension module `cheval._cheval`: the library's typed errors as Python exceptions, the numpy
 // hand-over helpers, and the registration of every binding. python/cheval/__init__.py is the public
 // face over it (docs/python.md).
+#include <charconv>
 #include <exception>
 #include <string>
 
@@ -8,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "cheval/common/error.h"
+#include "cheval/traj/stamp.h"
 #include "cheval/traj/validate.h"
 
 namespace cheval::python {
@@ -98,16 +100,52 @@ py::array AdoptMatrix(Eigen::MatrixXd&& matrix) {
                             {kDouble, rows * kDouble});
 }
 
+bool QuatOrderIsWxyz(const std::string& quat_order) {
+  if (quat_order != "xyzw" && quat_order != "wxyz") {
+    throw UsageError(fmt::format("quat_order: expected 'xyzw' or 'wxyz', got '{}'", quat_order));
+  }
+  return quat_order == "wxyz";
+}
+
+namespace {
+
+// Float seconds as the readers take decimal text: each value's shortest round-trip decimal
+// (std::to_chars, the digits Python's repr shows) parsed exactly (traj::ParseDecimalStamp, halves to
+// even at the nanosecond), so 1403715529.1121435 gives the stamp a TUM file with that text gives.
+py::array_t<int64_t> StampsFromSeconds(const py::array& array) {
+  const auto seconds = py::array_t<double, py::array::forcecast>::ensure(array);
+  const auto view = seconds.unchecked<1>();
+  py::array_t<int64_t> out(view.shape(0));
+  auto stamps = out.mutable_unchecked<1>();
+  for (py::ssize_t i = 0; i < view.shape(0); ++i) {
+    char text[64];
+    const auto [end, error] = std::to_chars(text, text + sizeof text, view(i));
+    const std::string_view decimal(text, error == std::errc() ? static_cast<size_t>(end - text) : 0);
+    const traj::StampParseResult r = traj::ParseDecimalStamp(decimal, 9);
+    if (r.error) {
+      throw InputError("<array>", 0, 0,
+                       fmt::format("row {}: stamps[{}] = {}: {}", i, i, decimal,
+                                   *r.error == traj::StampParseError::kOutOfRange
+                                       ? "beyond int64 nanoseconds (about +-292 years)"
+                                       : "not a finite number of seconds"));
+    }
+    stamps(i) = r.value;
+  }
+  return StampsArray(out);  // the span check of integer stamps
+}
+
+}  // namespace
+
 py::array_t<int64_t> StampsArray(const py::handle& stamps) {
   const py::array array = py::array::ensure(stamps);
   if (!array) throw py::type_error("stamps: expected an array of integer nanoseconds");
   const char kind = array.dtype().kind();
-  if (kind != 'i' && kind != 'u') {
-    throw py::type_error("stamps must be integer nanoseconds (int64), got dtype " +
-                         py::str(array.dtype()).cast<std::string>() +
-                         "; from seconds: numpy.round(seconds * 1e9).astype(numpy.int64)");
-  }
   if (array.ndim() != 1) throw py::value_error("stamps: expected a 1-D array, got " + std::to_string(array.ndim()) + "-D");
+  if (kind == 'f') return StampsFromSeconds(array);
+  if (kind != 'i' && kind != 'u') {
+    throw py::type_error("stamps must be integer nanoseconds (int64) or float seconds, got dtype " +
+                         py::str(array.dtype()).cast<std::string>());
+  }
   if (kind == 'u' && array.itemsize() == sizeof(uint64_t)) {
     // A cast to int64 would wrap 2^63 and beyond to negative stamps.
     const auto unsigned_stamps = py::array_t<uint64_t, py::array::forcecast>::ensure(array);

@@ -33,7 +33,9 @@ std::optional<DoubleArray> OptionalRealArray(const py::handle& values, const cha
 // Builds a trajectory from arrays and checks its values as the readers check a file's
 // (traj::ValidatePoses: finite values, rotations, stamp span; InputError, a ValueError, naming the row).
 PyTrajectory FromArrays(const py::handle& stamps_in, const py::handle& positions_in, const py::handle& quaternions_in,
-                        const py::handle& velocities_in, const py::handle& angular_velocities_in) {
+                        const py::handle& velocities_in, const py::handle& angular_velocities_in,
+                        const std::string& quat_order) {
+  const bool wxyz = QuatOrderIsWxyz(quat_order);
   const py::array_t<int64_t> stamps = StampsArray(stamps_in);
   const DoubleArray positions = RealArray(positions_in, "positions");
   const std::optional<DoubleArray> quaternions = OptionalRealArray(quaternions_in, "quaternions");
@@ -49,10 +51,13 @@ PyTrajectory FromArrays(const py::handle& stamps_in, const py::handle& positions
   channels.velocity = velocities.has_value();
   channels.angular_velocity = angular_velocities.has_value();
   PyTrajectory out{traj::Trajectory(channels)};
+  out.quat_wxyz = wxyz;
   out.trajectory.Reserve(n);
   auto row = [](const std::optional<DoubleArray>& a, py::ssize_t i) { return a ? a->data(i, 0) : nullptr; };
   for (py::ssize_t i = 0; i < n; ++i) {
-    out.trajectory.Append(stamps.at(i), positions.data(i, 0), row(quaternions, i), row(velocities, i),
+    const double* q = row(quaternions, i);
+    const double xyzw[4] = {q && wxyz ? q[1] : 0, q && wxyz ? q[2] : 0, q && wxyz ? q[3] : 0, q && wxyz ? q[0] : 0};
+    out.trajectory.Append(stamps.at(i), positions.data(i, 0), wxyz && q ? xyzw : q, row(velocities, i),
                           row(angular_velocities, i));
   }
   traj::ValidatePoses(out.trajectory.View(), out.path);
@@ -115,7 +120,8 @@ the arrays in (n int64 stamps; (n, 3) positions in m; (n, 4) quaternions x y z w
 (n, 3) rad/s). Stamps must be integers (nanoseconds): floats raise TypeError. Trajectories
 are immutable; the array properties are read-only views of the stored data (no copy).)")
       .def(py::init(&FromArrays), py::arg("stamps"), py::arg("positions"), py::arg("quaternions") = py::none(),
-           py::arg("velocities") = py::none(), py::arg("angular_velocities") = py::none())
+           py::arg("velocities") = py::none(), py::arg("angular_velocities") = py::none(),
+           py::arg("quat_order") = "xyzw")
       .def("__len__", [](const PyTrajectory& t) { return t.trajectory.size(); })
       .def("__repr__",
            [](const PyTrajectory& t) {
@@ -142,18 +148,27 @@ are immutable; the array properties are read-only views of the stored data (no c
       .def_property_readonly(
           "quaternions",
           [](const py::object& self) -> py::object {
-            const auto& t = self.cast<const PyTrajectory&>().trajectory;
+            const PyTrajectory& p = self.cast<const PyTrajectory&>();
+            const auto& t = p.trajectory;
+            py::object xyzw = py::none();
             switch (t.channels().orientation) {
               case traj::OrientationKind::kQuaternion:
-                return ViewOf(t.raw_orientations().data(), {t.size(), 4}, {4 * kDouble, kDouble}, self);
-              case traj::OrientationKind::kMatrix: return QuaternionsOf(t.View());
+                xyzw = ViewOf(t.raw_orientations().data(), {t.size(), 4}, {4 * kDouble, kDouble}, self);
+                break;
+              case traj::OrientationKind::kMatrix: xyzw = QuaternionsOf(t.View()); break;
               case traj::OrientationKind::kNone: break;
             }
-            return py::none();
+            if (xyzw.is_none() || !p.quat_wxyz) return xyzw;
+            return py::module_::import("numpy").attr("roll")(xyzw, 1, py::arg("axis") = 1);  // w first (a copy)
           },
-          "Orientations as quaternions (x, y, z, w), shape (n, 4): exactly as read (not normalised; a view, no "
-          "copy) when the file stores quaternions; unit quaternions of the matrices (a copy) for KITTI; None "
+          "Orientations as quaternions, shape (n, 4), in the trajectory's quat_order (x, y, z, w unless "
+          "'wxyz' was asked): exactly as read (not normalised; a view, no copy, in x y z w) when the file "
+          "stores quaternions; unit quaternions of the matrices (a copy) for KITTI; a copy in w x y z; None "
           "for a position-only trajectory.")
+      .def_property_readonly(
+          "quat_order", [](const PyTrajectory& t) { return std::string(t.quat_wxyz ? "wxyz" : "xyzw"); },
+          "The order of the quaternion arrays this trajectory takes and gives: 'xyzw' (cheval's, TUM's) or "
+          "'wxyz' (evo's orientations_quat_wxyz, EuRoC's).")
       .def_property_readonly(
           "rotations",
           [](const py::object& self) -> py::object {
@@ -197,7 +212,7 @@ are immutable; the array properties are read-only views of the stored data (no c
   m.def(
       "read",
       [](const std::string& path, const std::string& format, const std::string& columns,
-         const std::string& kitti_times, const std::string& topic, bool bag_time) {
+         const std::string& kitti_times, const std::string& topic, bool bag_time, const std::string& quat_order) {
         traj::ReadOptions options = traj::ReadOptions::FromNames(format, columns, kitti_times);
         options.topic = topic;
         options.record_time = bag_time;
@@ -207,10 +222,11 @@ are immutable; the array properties are read-only views of the stored data (no c
           out.trajectory = traj::ReadTrajectory(path, options, &out.format);
         }
         out.path = path;
+        out.quat_wxyz = QuatOrderIsWxyz(quat_order);
         return out;
       },
       py::arg("path"), py::arg("format") = "auto", py::arg("columns") = "", py::arg("kitti_times") = "",
-      py::arg("topic") = "", py::arg("bag_time") = false,
+      py::arg("topic") = "", py::arg("bag_time") = false, py::arg("quat_order") = "xyzw",
       R"(Reads a trajectory file exactly as the CLI does (docs/formats.md).
 
 format: auto, tum, tumv, euroc, kitti, vins or csv; columns: a column map such as

@@ -156,9 +156,9 @@ class ErrorTest(unittest.TestCase):
 
     def test_bad_arrays_and_arguments(self):
         arrays = example()
-        with self.assertRaises(TypeError) as raised:
-            cheval.Trajectory(arrays["stamps"] * 1e-9, arrays["positions"])  # float seconds
-        self.assertIn("integer nanoseconds", str(raised.exception))
+        with self.assertRaises(TypeError) as raised:  # float seconds are taken (test_arrays_io.py); text is not
+            cheval.Trajectory(arrays["stamps"].astype(str), arrays["positions"])
+        self.assertIn("integer nanoseconds (int64) or float seconds", str(raised.exception))
         with self.assertRaises(cheval.UsageError) as raised:
             cheval.Trajectory(arrays["stamps"], arrays["positions"][:, :2])
         self.assertEqual(str(raised.exception), "positions: expected shape (50, 3) (one row per stamp), got (50, 2)")

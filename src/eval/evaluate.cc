@@ -12,6 +12,7 @@
 #include "cheval/cheb/curve.h"
 #include "cheval/common/error.h"
 #include "cheval/common/options.h"
+#include "cheval/eval/res_table.h"  // CsvField
 #include "cheval/traj/stamp.h"
 #include "enum_names.h"
 
@@ -346,18 +347,6 @@ EvaluationResult Evaluate(const traj::TrajectoryView& ref, const traj::Trajector
 namespace {
 
 using Json = nlohmann::ordered_json;
-
-// A text field of a CSV row as RFC 4180 has it: in double quotes, inner quotes doubled, when it holds a
-// comma, a quote, a CR or a LF (a file name may); as it is otherwise.
-std::string CsvField(std::string_view text) {
-  if (text.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(text);
-  std::string quoted = "\"";
-  for (const char c : text) {
-    if (c == '"') quoted += '"';
-    quoted += c;
-  }
-  return quoted + '"';
-}
 
 // A mean over `count` items: null when there are none.
 Json OrNull(Eigen::Index count, double mean) { return count > 0 ? Json(mean) : Json(nullptr); }

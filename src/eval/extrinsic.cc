@@ -10,6 +10,7 @@
 
 #include "cheval/common/error.h"
 #include "cheval/common/input_file.h"
+#include "cheval/common/npy.h"
 
 namespace cheval::eval {
 namespace {
@@ -108,43 +109,16 @@ Extrinsic FromText(std::string_view content, const std::string& path) {
   return FromMatrix(Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(values.data()), path);
 }
 
-// A 4x4 float64 .npy array (format versions 1-3).
+// A 4x4 .npy array (common/npy.h: format versions 1-3, float64 or another numeric dtype, C or Fortran order).
 Extrinsic FromNpy(std::string_view content, const std::string& path) {
-  auto bad = [&](const std::string& what) { Fail(path, 0, "not a 4x4 float64 .npy array: " + what); };
-  if (content.size() < 10 || content.substr(0, 6) != "\x93NUMPY") bad("no .npy magic (\\x93NUMPY)");
-  const int major = static_cast<unsigned char>(content[6]);
-  size_t header_len = 0, offset = 0;
-  if (major == 1) {
-    header_len = static_cast<unsigned char>(content[8]) | (static_cast<size_t>(static_cast<unsigned char>(content[9])) << 8);
-    offset = 10;
-  } else if (major == 2 || major == 3) {
-    if (content.size() < 12) bad("truncated header");
-    for (int k = 0; k < 4; ++k) header_len |= static_cast<size_t>(static_cast<unsigned char>(content[8 + k])) << (8 * k);
-    offset = 12;
-  } else {
-    bad(fmt::format("format version {}, expected 1, 2 or 3", major));
-  }
-  if (header_len > content.size() - offset) bad("truncated header");
-  std::string header(content.substr(offset, header_len));
-  header.erase(std::remove_if(header.begin(), header.end(), [](char c) { return c == ' '; }), header.end());
-  const bool little = header.find("'descr':'<f8'") != std::string::npos;
-  const bool big = header.find("'descr':'>f8'") != std::string::npos;
-  if (!little && !big) bad("dtype is not float64 ('<f8' or '>f8'): header " + header);
-  if (header.find("'shape':(4,4)") == std::string::npos) bad("shape is not (4, 4): header " + header);
-  const bool fortran = header.find("'fortran_order':True") != std::string::npos;
-  const size_t data = offset + header_len;
-  if (content.size() - data != 16 * sizeof(double)) {
-    bad(fmt::format("{} bytes of data, expected 128", content.size() - data));
-  }
-  double values[16];
-  for (int k = 0; k < 16; ++k) {
-    unsigned char bytes[8];
-    std::memcpy(bytes, content.data() + data + 8 * k, 8);
-    if (big) std::reverse(bytes, bytes + 8);
-    std::memcpy(&values[k], bytes, 8);  // the machine is little endian (x86, ARM as built)
+  const NpyArray a = ParseNpy(content, path, "not a 4x4 float64 .npy array");
+  if (a.shape != std::vector<uint64_t>{4, 4}) {
+    std::string shape;
+    for (uint64_t d : a.shape) shape += (shape.empty() ? "" : ", ") + std::to_string(d);
+    Fail(path, 0, fmt::format("not a 4x4 float64 .npy array: shape is ({}), expected (4, 4)", shape));
   }
   Eigen::Matrix4d m;
-  for (int k = 0; k < 16; ++k) (fortran ? m(k % 4, k / 4) : m(k / 4, k % 4)) = values[k];
+  for (int k = 0; k < 16; ++k) m(k / 4, k % 4) = a.values[static_cast<size_t>(k)];
   return FromMatrix(m, path);
 }
 

@@ -80,3 +80,7 @@ namespace cheval::cli {
 void RegisterEstimateRotors(CLI::App& app, Action* action);
 void RegisterIdentifyRotors(CLI::App& app, Action* action);
 }  // namespace cheval::cli
+namespace cheval::cli {
+/// `cheval res FILE...` (tools/cheval/res.cc): evo_res's table of result files.
+void RegisterRes(CLI::App& app, Action* action);
+}  // namespace cheval::cli

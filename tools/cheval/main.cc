@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
   cheval::cli::RegisterEstimateRotors(app, &action);
   cheval::cli::RegisterIdentifyRotors(app, &action);
   cheval::cli::RegisterTable(app, &action);
+  cheval::cli::RegisterRes(app, &action);
   cheval::cli::CheckNumericOptions(&app);
 
   auto fail = [](ExitCode code, const std::string& message) {

@@ -107,6 +107,9 @@ constexpr std::array kEvo = std::to_array<EvoSpelling>({
     {"--full_check", "--full-check", true},
     {"-p", "no plot window: cheval report REF EST -o FILE.html", false},
     {"--plot", "no plot window: cheval report REF EST -o FILE.html", false},
+    {"--save_table", "--save-table", true},
+    {"--use_filenames", "--use-filenames", true},
+    {"--ignore_title", "--ignore-title", true},
 });
 
 std::string Normalized(std::string_view flag) {
