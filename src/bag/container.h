@@ -28,6 +28,10 @@ struct Connection {
 struct Visitor {
   std::function<bool(uint64_t id, const Connection&)> on_connection;
   std::function<void(uint64_t id, int64_t log_time_ns, std::string_view data)> on_message;
+  // Optional: the recording's start as its index or metadata gives it (the earliest log time of any
+  // message: ROS 1 chunk infos, ROS 2 metadata.yaml `starting_time`, MCAP message records), called
+  // once after the messages when the recording holds any.
+  std::function<void(int64_t start_ns)> on_start_time;
 };
 
 // Walks one recording with a visitor (a reader bound to its source).

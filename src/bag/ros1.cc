@@ -118,8 +118,9 @@ T FieldValue(const Record& record, std::string_view name, const std::string& pat
   return out;
 }
 
-int64_t TimeNs(const Record& record, const std::string& path, const std::string& where) {
-  const uint64_t time = FieldValue<uint64_t>(record, "time", path, where);
+int64_t TimeNs(const Record& record, const std::string& path, const std::string& where,
+               std::string_view field = "time") {
+  const uint64_t time = FieldValue<uint64_t>(record, field, path, where);
   const uint32_t sec = static_cast<uint32_t>(time & 0xffffffffu);
   const uint32_t nsec = static_cast<uint32_t>(time >> 32);
   return static_cast<int64_t>(sec) * 1000000000 + nsec;
@@ -161,6 +162,10 @@ class Ros1Reader {
           conns.insert(data.Read<uint32_t>());
           data.Read<uint32_t>();  // count
         }
+        if (!conns.empty()) {
+          const int64_t start = TimeNs(record, path_, "", "start_time");
+          start_ns_ = start_ns_ < 0 ? start : std::min(start_ns_, start);
+        }
       }
       records.push_back(record);
     }
@@ -189,6 +194,10 @@ class Ros1Reader {
         throw InputError(path_, 0, 0, fmt::format("message data record at byte {}: outside a chunk", record.offset));
       }
     }
+    // The start as rosbags gives it: the earliest chunk info start_time (without chunk infos, the
+    // earliest message of the chunks read, which are then all of them).
+    if (start_ns_ < 0) start_ns_ = first_message_ns_;
+    if (start_ns_ >= 0 && visitor_.on_start_time) visitor_.on_start_time(start_ns_);
   }
 
  private:
@@ -253,7 +262,9 @@ class Ros1Reader {
                                                     where, record.offset, conn));
         }
         ++(*counts)[conn];
-        if (it->second) visitor_.on_message(conn, TimeNs(record, path_, where), record.data);
+        const int64_t time = TimeNs(record, path_, where);
+        first_message_ns_ = first_message_ns_ < 0 ? time : std::min(first_message_ns_, time);
+        if (it->second) visitor_.on_message(conn, time, record.data);
       } else {
         throw InputError(path_, 0, 0, fmt::format("{}{} at byte {} (op {:#04x}): expected connection or message data "
                                                   "records inside a chunk",
@@ -266,6 +277,8 @@ class Ros1Reader {
   const Visitor& visitor_;
   std::unordered_map<uint32_t, bool> wanted_;  // connection -> messages wanted
   std::map<uint64_t, std::set<uint32_t>> chunk_connections_;
+  int64_t start_ns_ = -1;          // earliest chunk info start_time
+  int64_t first_message_ns_ = -1;  // earliest message read
 };
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <sqlite3.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -13,7 +14,7 @@
 namespace cheval::bag {
 namespace {
 
-void ReadSqlite(const std::string& path, const Visitor& visitor, uint64_t file_index) {
+void ReadSqlite(const std::string& path, const Visitor& visitor, uint64_t file_index, int64_t* first_ns) {
   sqlite3* raw = nullptr;
   if (!std::filesystem::is_regular_file(path)) throw InputError(path, 0, 0, "cannot open the file (named by metadata.yaml)");
   const int opened = sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr);
@@ -56,8 +57,9 @@ void ReadSqlite(const std::string& path, const Visitor& visitor, uint64_t file_i
     if (it == wanted.end()) {
       throw InputError(path, 0, 0, fmt::format("table 'messages': topic_id {} is not in table 'topics'", topic));
     }
-    if (!it->second) continue;
     const int64_t time = sqlite3_column_int64(messages.get(), 1);
+    *first_ns = *first_ns < 0 ? time : std::min(*first_ns, time);
+    if (!it->second) continue;
     const void* blob = sqlite3_column_blob(messages.get(), 2);
     const int size = sqlite3_column_bytes(messages.get(), 2);
     visitor.on_message(base + static_cast<uint64_t>(topic), time,
@@ -94,6 +96,7 @@ void ReadRos2(const std::string& folder, const Visitor& visitor) {
       throw InputError(metadata_name, 0, 0, "no 'relative_file_paths' list");
     }
     uint64_t index = 0;
+    int64_t first_ns = -1;
     for (const YAML::Node& file : files) {
       const std::string path = (std::filesystem::path(folder) / file.as<std::string>()).string();
       if (storage == "mcap") {
@@ -102,12 +105,17 @@ void ReadRos2(const std::string& folder, const Visitor& visitor) {
         Visitor shifted;
         shifted.on_connection = [&](uint64_t id, const Connection& c) { return visitor.on_connection(base + id, c); };
         shifted.on_message = [&](uint64_t id, int64_t t, std::string_view d) { visitor.on_message(base + id, t, d); };
+        shifted.on_start_time = [&](int64_t t) { first_ns = first_ns < 0 ? t : std::min(first_ns, t); };
         ReadMcap(path, shifted);
       } else {
-        ReadSqlite(path, visitor, index);
+        ReadSqlite(path, visitor, index, &first_ns);
       }
       ++index;
     }
+    // The start as rosbags gives it: metadata.yaml's starting_time (else the earliest message read).
+    const YAML::Node start = info["starting_time"]["nanoseconds_since_epoch"];
+    if (start && start.IsScalar()) first_ns = start.as<int64_t>();
+    if (first_ns >= 0 && visitor.on_start_time) visitor.on_start_time(first_ns);
   } catch (const YAML::Exception& e) {
     throw InputError(metadata_name, e.mark.line + 1, e.mark.column + 1, fmt::format("unexpected content: {}", e.msg));
   }

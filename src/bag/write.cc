@@ -381,10 +381,13 @@ void WriteRos2(const std::string& folder, const std::vector<TopicToWrite>& topic
     sqlite3_reset(statement);
   }
   exec("COMMIT;");
+  const int64_t first = entries.empty() ? 0 : entries.front().time;
+  const int64_t last = entries.empty() ? 0 : entries.back().time;
   const std::string yaml = fmt::format(
       "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: sqlite3\n  compression_format: ''\n"
-      "  compression_mode: ''\n  relative_file_paths:\n  - {}\n  message_count: {}\n  topics_with_message_count:\n{}",
-      db_name, entries.size(), yaml_topics);
+      "  compression_mode: ''\n  relative_file_paths:\n  - {}\n  message_count: {}\n  starting_time:\n"
+      "    nanoseconds_since_epoch: {}\n  duration:\n    nanoseconds: {}\n  topics_with_message_count:\n{}",
+      db_name, entries.size(), first, last - first, yaml_topics);
   WriteOutput((std::filesystem::path(folder) / "metadata.yaml").string(), yaml);
 }
 
