@@ -59,6 +59,9 @@ std::string ReadFileBytes(const std::string& path);
 std::string Decompress(std::string_view compression, std::string_view data, uint64_t size, const std::string& path,
                        const std::string& what);
 
+// One zstd frame, whether or not its header records the uncompressed size (ROS 2 compressed bags).
+std::string DecompressZstd(std::string_view data, const std::string& path, const std::string& what);
+
 // A little-endian cursor over bytes that throws InputError on a read past the end, naming what it
 // reads as `PREFIX LABEL NUMBER` ("chunk at byte 4109: record at byte 70"); the name is formatted
 // only on failure (a cursor is made per record and per message).

@@ -76,6 +76,7 @@ class RoundTrip : public ::testing::TestWithParam<Case> {
     options.container = std::get<0>(GetParam());
     options.compression = std::get<1>(GetParam());
     options.mcap_encoding = std::get<2>(GetParam());
+    if (options.container == Container::kRos2) options.ros2_compression_mode = std::get<2>(GetParam());
     options.messages_per_chunk = 7;  // several chunks
     const std::string path = dir / (options.container == Container::kRos2 ? "bag" : "bag.bin");
     WriteBag(path, topics, options);
@@ -150,7 +151,8 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{Container::kRos1, "lz4", "cdr"}, Case{Container::kMcap, "none", "cdr"},
                       Case{Container::kMcap, "zstd", "cdr"}, Case{Container::kMcap, "lz4", "cdr"},
                       Case{Container::kMcap, "zstd", "ros1"}, Case{Container::kMcap, "none", "ros1"},
-                      Case{Container::kRos2, "none", "cdr"}),
+                      Case{Container::kRos2, "none", "cdr"}, Case{Container::kRos2, "zstd", "file"},
+                      Case{Container::kRos2, "zstd", "message"}),
     [](const ::testing::TestParamInfo<Case>& param) {
       return std::string(ToString(std::get<0>(param.param))) + "_" + std::get<1>(param.param) + "_" +
              std::get<2>(param.param);
