@@ -4,6 +4,7 @@
 // the recording's start up to the latest time common to the chain's edges, and the times tf2 cannot
 // answer without extrapolating are left out.
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 #include "message_reader.h"
@@ -130,23 +131,30 @@ traj::Trajectory ReadTfTrajectory(const std::string& path, const TfChain& chain,
   if (common != TfStatus::kOk) fail(common, 0);
   // evo's lookup times: from the recording's start every 0.1 s while <= the latest common time; a
   // chain of static edges only (latest common time 0, before the start) is looked up once, at 0.
-  constexpr int64_t kStepNs = 100000000;  // 1 / tf_cache_lookup_frequency (10 Hz)
-  std::vector<int64_t> times;
-  if (start_ns < 0 || latest < start_ns) {
-    times.push_back(latest);
-  } else {
-    times.reserve(static_cast<size_t>((latest - start_ns) / kStepNs + 1));
-    for (int64_t t = start_ns; t <= latest; t += kStepNs) times.push_back(t);
+  constexpr int64_t kStepNs = 100000000;       // 1 / tf_cache_lookup_frequency (10 Hz)
+  constexpr int64_t kMaxLookups = 10000000;     // 11.6 days at 10 Hz
+  const bool once = start_ns < 0 || latest < start_ns;
+  const int64_t lookups = once ? 1 : (latest - start_ns) / kStepNs + 1;
+  if (lookups > kMaxLookups) {
+    throw ComputeError(fmt::format("{}: tf chain {}: {} lookups from the recording's start ({} ns) every 0.1 s to the "
+                                   "latest common time ({} ns); more than {} is taken for broken stamps",
+                                   path, name, lookups, start_ns, latest, kMaxLookups));
   }
   traj::Trajectory trajectory;
-  trajectory.Reserve(static_cast<Eigen::Index>(times.size()));
-  for (const int64_t t : times) {
+  for (int64_t k = 0; k < lookups; ++k) {
+    const int64_t t = once ? latest : start_ns + k * kStepNs;
     TfPose pose;
     const TfStatus status = buffer.Lookup(chain.parent, chain.child, t, &pose);
     if (status == TfStatus::kExtrapolation) continue;  // evo skips tf2's ExtrapolationException
     if (status != TfStatus::kOk) fail(status, t);
     const double position[3] = {pose.translation.x, pose.translation.y, pose.translation.z};
     const double orientation[4] = {pose.rotation.x, pose.rotation.y, pose.rotation.z, pose.rotation.w};
+    if (!std::all_of(position, position + 3, [](double x) { return std::isfinite(x); }) ||
+        !std::all_of(orientation, orientation + 4, [](double x) { return std::isfinite(x); })) {
+      throw ComputeError(fmt::format("{}: tf chain {}: the pose at {} ns is not finite (the transforms' products "
+                                     "overflow)",
+                                     path, name, t));
+    }
     trajectory.Append(pose.stamp_ns, position, orientation);
   }
   if (trajectory.empty()) {
