@@ -15,6 +15,7 @@
 #include "cheval/bag/bag.h"
 #include "cheval/common/error.h"
 #include "tf.h"
+#include "tf_buffer.h"
 
 #ifndef CHEVAL_DATA_DIR
 #define CHEVAL_DATA_DIR ""
@@ -137,6 +138,53 @@ TEST(TfTopic, ParsesEvosIdentifiers) {
   EXPECT_FALSE(ParseTfTopic("/pose").has_value());
   EXPECT_THROW(ParseTfTopic("/tf:odom"), UsageError);
   EXPECT_THROW(ParseTfTopic("/tf:.base"), UsageError);
+}
+
+TfPose At(int64_t t, double x, double qw = 1.0) {
+  TfPose p;
+  p.stamp_ns = t;
+  p.translation = {x, 0, 0};
+  p.rotation = {0, 0, 0, qw};
+  return p;
+}
+
+// tf2's caches as evo fills them; each case would come out otherwise under a simpler rule.
+TEST(TfBuffer, CachesAsTf2) {
+  TfBuffer buffer;
+  ASSERT_TRUE(buffer.Set("a", "b", At(1 * kS, 1.0), false));
+  ASSERT_TRUE(buffer.Set("/a", "b", At(2 * kS, 2.0), false));  // a leading '/' is dropped
+  ASSERT_TRUE(buffer.Set("a", "b", At(2 * kS, 5.0), false));   // the same stamp again, other data
+  EXPECT_FALSE(buffer.Set("a", "b", At(3 * kS, 7.0, 2.0), false));  // |q|^2 = 4: ignored
+  EXPECT_FALSE(buffer.Set("b", "b", At(3 * kS, 7.0), false));       // to itself: ignored
+  // a -> c dynamic, then static (evo reads /tf_static after /tf): the static one replaces it.
+  ASSERT_TRUE(buffer.Set("a", "c", At(1 * kS, 3.0), false));
+  ASSERT_TRUE(buffer.Set("a", "c", At(0, 9.0), true));
+  buffer.Finish();
+  TfPose p;
+  // At the newest stamp: the last transform stamped there; between: the first one stamped there.
+  ASSERT_EQ(buffer.Lookup("a", "b", 2 * kS, &p), TfStatus::kOk);
+  EXPECT_EQ(p.translation.x, 5.0);
+  ASSERT_EQ(buffer.Lookup("a", "b", 3 * kS / 2, &p), TfStatus::kOk);
+  EXPECT_EQ(p.translation.x, 1.5);
+  EXPECT_EQ(p.stamp_ns, 3 * kS / 2);
+  EXPECT_EQ(buffer.Lookup("a", "b", 3 * kS, &p), TfStatus::kExtrapolation);  // the ignored one
+  ASSERT_EQ(buffer.Lookup("a", "c", 5 * kS, &p), TfStatus::kOk);
+  EXPECT_EQ(p.translation.x, 9.0);
+  int64_t latest = -1;
+  ASSERT_EQ(buffer.LatestCommonTime("b", "c", &latest), TfStatus::kOk);
+  EXPECT_EQ(latest, 2 * kS);  // the static edge has no time of its own
+  EXPECT_EQ(buffer.Lookup("a", "nowhere", kS, &p), TfStatus::kUnknownFrame);
+}
+
+TEST(TfBuffer, PrunesToTheCacheTime) {
+  TfBuffer buffer;  // evo's 1e4 s
+  ASSERT_TRUE(buffer.Set("a", "b", At(1 * kS, 1.0), false));
+  ASSERT_TRUE(buffer.Set("a", "b", At(10002 * kS, 2.0), false));
+  ASSERT_TRUE(buffer.Set("a", "b", At(10003 * kS, 3.0), false));  // prunes what is older than 2 s
+  buffer.Finish();
+  TfPose p;
+  EXPECT_EQ(buffer.Lookup("a", "b", 1500 * kS, &p), TfStatus::kExtrapolation);
+  EXPECT_EQ(buffer.Lookup("a", "b", 10002 * kS, &p), TfStatus::kOk);
 }
 
 // evo's tf_example (ROS 1 and ROS 2): start 1714741164.111822142 (the first log time, and the ROS 2
