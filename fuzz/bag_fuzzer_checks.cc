@@ -63,12 +63,18 @@ std::optional<std::string> CheckBagInput(std::string_view container, std::string
   } else if (container == "mcap") {
     path = "fuzz.mcap";
     walk = [&](const bag::Visitor& v) { bag::ReadMcapBytes(data, path, v); };
-  } else if (container == "ros2") {
-    folder = std::filesystem::temp_directory_path() / fmt::format("cheval_fuzz_ros2_{}", ::getpid());
+  } else if (container == "ros2" || container == "ros2_file" || container == "ros2_message") {
+    // ros2_file: the input is a zstd-compressed database (compression_mode FILE); ros2_message: a
+    // database whose messages are zstd frames (MESSAGE).
+    folder = std::filesystem::temp_directory_path() / fmt::format("cheval_fuzz_{}_{}", container, ::getpid());
     std::filesystem::create_directories(folder);
-    std::ofstream(folder / "fuzz.db3", std::ios::binary).write(data.data(), static_cast<std::streamsize>(data.size()));
+    const std::string file = container == "ros2_file" ? "fuzz.db3.zstd" : "fuzz.db3";
+    const std::string compression = container == "ros2" ? "''" : "zstd";
+    const std::string mode = container == "ros2" ? "''" : container == "ros2_file" ? "FILE" : "MESSAGE";
+    std::ofstream(folder / file, std::ios::binary).write(data.data(), static_cast<std::streamsize>(data.size()));
     std::ofstream(folder / "metadata.yaml") << "rosbag2_bagfile_information:\n  storage_identifier: sqlite3\n"
-                                               "  relative_file_paths:\n  - fuzz.db3\n";
+                                               "  compression_format: " << compression << "\n  compression_mode: "
+                                            << mode << "\n  relative_file_paths:\n  - " << file << "\n";
     path = folder.string();
     walk = [&](const bag::Visitor& v) { bag::ReadRos2(path, v); };
   } else {

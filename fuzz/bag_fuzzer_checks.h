@@ -11,8 +11,10 @@
 namespace cheval::fuzz {
 
 /// The containers: "ros1" (the bytes are a ROS 1 bag), "mcap" (an MCAP file), "ros2" (the bytes are
-/// the sqlite3 database of a ROS 2 folder whose metadata.yaml names it).
-inline constexpr std::array<std::string_view, 3> kBagTargets{{"ros1", "mcap", "ros2"}};
+/// the sqlite3 database of a ROS 2 folder whose metadata.yaml names it), "ros2_file" (that database
+/// zstd-compressed, compression_mode FILE), "ros2_message" (a database of zstd-compressed messages,
+/// compression_mode MESSAGE).
+inline constexpr std::array<std::string_view, 5> kBagTargets{{"ros1", "mcap", "ros2", "ros2_file", "ros2_message"}};
 
 /// Lists the topics of the recording in `data` and reads every topic of a pose type (header and
 /// record time) and, for a TFMessage topic, the chain TOPIC:world.body. Fine: each step gives a

@@ -108,13 +108,17 @@ def write_model(model, path):
     _cheval.write_model(model, _path(path))
 
 
-def _trajectory(source, format="auto", columns=None, kitti_times=None, quat_order=None):
+def _trajectory(source, format="auto", columns=None, kitti_times=None, quat_order=None, topic=None,
+                bag_time=False):
     """A Trajectory from a path, a Trajectory or a mapping of its constructor's arguments (quaternions in
-    quat_order, else the mapping's own 'quat_order', else x y z w; stamps int64 ns or float seconds)."""
+    quat_order, else the mapping's own 'quat_order', else x y z w; stamps int64 ns or float seconds);
+    topic / bag_time for a recording's path (docs/bags.md)."""
+    if (topic is not None or bag_time) and not isinstance(source, (str, _os.PathLike)):
+        raise TypeError("topic / bag_time apply to a recording's path, not to a " + type(source).__name__)
     if isinstance(source, Trajectory):
         return source
     if isinstance(source, (str, _os.PathLike)):
-        return read(source, format, columns, kitti_times, quat_order=quat_order or "xyzw")
+        return read(source, format, columns, kitti_times, topic, bag_time, quat_order=quat_order or "xyzw")
     if isinstance(source, _Mapping):
         arrays = dict(source)
         if quat_order is not None:
@@ -211,12 +215,15 @@ def _sides(ref, est, options):
         def get(name):
             value = options.get(prefix + name)
             return options.get(name) if value is None else value
-        return _trajectory(source, get("format") or "auto", get("columns"), get("kitti_times"), get("quat_order"))
+        return _trajectory(source, get("format") or "auto", get("columns"), get("kitti_times"), get("quat_order"),
+                           get("topic"), bool(get("bag_time")))
     return side(ref, "ref_"), side(est, "est_")
 
 
 _INPUT_OPTIONS = {f"{prefix}{name}" for prefix in ("", "ref_", "est_")
                   for name in ("format", "columns", "kitti_times", "quat_order")}
+# Recordings (docs/bags.md): topic / ref_topic / est_topic and bag_time (record time) per side.
+_INPUT_OPTIONS |= {f"{prefix}{name}" for prefix in ("", "ref_", "est_") for name in ("topic", "bag_time")}
 
 
 def _check_input_options(function, options):
@@ -262,6 +269,7 @@ def _evaluate(metric, ref, est, errors, inputs, options):
 _COMMON_DOC = """
     ref, est: paths, Trajectories or mappings of arrays. Input options as the CLI's: format,
     columns, kitti_times for both files, ref_format, est_columns, ... for one side.
+    Recordings: topic (both sides), ref_topic / est_topic (e.g. '/tf:odom.base_link'), bag_time.
     align: 'none', 'origin', 'se3', 'sim3', 'scale', 'posyaw' or 'full'; n_align: solve it from the
     first N pairs; t_max_diff, t_offset (s): the association (est + t_offset = ref);
     association: 'nearest' (evo) or 'continuous' (the reference's Chebyshev curve at the estimate

@@ -3,6 +3,7 @@
 #include <lz4frame.h>
 #include <zstd.h>
 
+#include <algorithm>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -67,6 +68,33 @@ std::string Decompress(std::string_view compression, std::string_view data, uint
   } else {
     throw InputError(path, 0, 0, fmt::format("{}: unknown compression '{}'; expected {}", what, compression,
                                              "none, bz2 or lz4 (ROS 1), zstd or lz4 (MCAP)"));
+  }
+  return out;
+}
+
+std::string DecompressZstd(std::string_view data, const std::string& path, const std::string& what) {
+  const unsigned long long size = ZSTD_getFrameContentSize(data.data(), data.size());
+  if (size == ZSTD_CONTENTSIZE_ERROR) {
+    throw InputError(path, 0, 0, fmt::format("{}: not zstd data (no zstd frame header)", what));
+  }
+  if (size != ZSTD_CONTENTSIZE_UNKNOWN) return Decompress("zstd", data, size, path, what);
+  // A frame written by a stream does not record its size: decompress in steps.
+  std::unique_ptr<ZSTD_DCtx, decltype(&ZSTD_freeDCtx)> context(ZSTD_createDCtx(), ZSTD_freeDCtx);
+  std::string out;
+  ZSTD_inBuffer in{data.data(), data.size(), 0};
+  size_t status = 1;
+  while (status != 0) {
+    const size_t used = out.size();
+    out.resize(used + std::max<size_t>(ZSTD_DStreamOutSize(), used));
+    ZSTD_outBuffer buffer{out.data() + used, out.size() - used, 0};
+    status = ZSTD_decompressStream(context.get(), &buffer, &in);
+    out.resize(used + buffer.pos);
+    if (ZSTD_isError(status)) {
+      throw InputError(path, 0, 0, fmt::format("{}: zstd data does not decompress: {}", what, ZSTD_getErrorName(status)));
+    }
+    if (status != 0 && in.pos == in.size && buffer.pos == 0) {
+      throw InputError(path, 0, 0, fmt::format("{}: zstd data does not decompress: truncated frame", what));
+    }
   }
   return out;
 }

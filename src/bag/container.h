@@ -28,6 +28,10 @@ struct Connection {
 struct Visitor {
   std::function<bool(uint64_t id, const Connection&)> on_connection;
   std::function<void(uint64_t id, int64_t log_time_ns, std::string_view data)> on_message;
+  // Optional: the recording's start as its index or metadata gives it (the earliest log time of any
+  // message: ROS 1 chunk infos, ROS 2 metadata.yaml `starting_time`, MCAP message records), called
+  // once after the messages when the recording holds any.
+  std::function<void(int64_t start_ns)> on_start_time;
 };
 
 // Walks one recording with a visitor (a reader bound to its source).
@@ -54,6 +58,9 @@ std::string ReadFileBytes(const std::string& path);
 // the record in messages ("chunk at byte 4117"). InputError on corrupt data or a size mismatch.
 std::string Decompress(std::string_view compression, std::string_view data, uint64_t size, const std::string& path,
                        const std::string& what);
+
+// One zstd frame, whether or not its header records the uncompressed size (ROS 2 compressed bags).
+std::string DecompressZstd(std::string_view data, const std::string& path, const std::string& what);
 
 // A little-endian cursor over bytes that throws InputError on a read past the end, naming what it
 // reads as `PREFIX LABEL NUMBER` ("chunk at byte 4109: record at byte 70"); the name is formatted

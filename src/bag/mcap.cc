@@ -3,6 +3,7 @@
 // (uncompressed, zstd or lz4 frames; the chunk's CRC-32 is checked when it is not 0). The summary
 // section after DataEnd is not needed and not read.
 #include <array>
+#include <algorithm>
 #include <map>
 
 #include "container.h"
@@ -42,6 +43,7 @@ class McapReader {
       throw InputError(path_, 0, 0, "not an MCAP file: expected the magic 89 4D 43 41 50 30 0D 0A at byte 0");
     }
     Records(bytes.substr(kMagic.size()), kMagic.size(), "");
+    if (start_ns_ >= 0 && visitor_.on_start_time) visitor_.on_start_time(start_ns_);
   }
 
  private:
@@ -76,6 +78,8 @@ class McapReader {
           const auto it = wanted_.find(channel);
           if (it == wanted_.end()) content.Fail(fmt::format("message on channel {}, which no channel record defines", channel));
           if (log_time > static_cast<uint64_t>(INT64_MAX)) content.Fail("log time beyond int64 nanoseconds");
+          const int64_t time = static_cast<int64_t>(log_time);
+          start_ns_ = start_ns_ < 0 ? time : std::min(start_ns_, time);
           if (it->second) visitor_.on_message(channel, static_cast<int64_t>(log_time), content.Bytes(content.remaining()));
           break;
         }
@@ -141,6 +145,7 @@ class McapReader {
   const Visitor& visitor_;
   std::map<uint16_t, std::string> schemas_;
   std::map<uint16_t, bool> wanted_;
+  int64_t start_ns_ = -1;  // earliest message log time
 };
 
 }  // namespace

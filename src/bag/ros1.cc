@@ -4,6 +4,7 @@
 // data records. Chunks are read in file order; the index data records after each chunk are checked
 // against the messages the chunk held.
 #include <algorithm>
+#include <future>
 #include <map>
 #include <set>
 #include <unordered_map>
@@ -118,8 +119,9 @@ T FieldValue(const Record& record, std::string_view name, const std::string& pat
   return out;
 }
 
-int64_t TimeNs(const Record& record, const std::string& path, const std::string& where) {
-  const uint64_t time = FieldValue<uint64_t>(record, "time", path, where);
+int64_t TimeNs(const Record& record, const std::string& path, const std::string& where,
+               std::string_view field = "time") {
+  const uint64_t time = FieldValue<uint64_t>(record, field, path, where);
   const uint32_t sec = static_cast<uint32_t>(time & 0xffffffffu);
   const uint32_t nsec = static_cast<uint32_t>(time >> 32);
   return static_cast<int64_t>(sec) * 1000000000 + nsec;
@@ -161,21 +163,39 @@ class Ros1Reader {
           conns.insert(data.Read<uint32_t>());
           data.Read<uint32_t>();  // count
         }
+        if (!conns.empty()) {
+          const int64_t start = TimeNs(record, path_, "", "start_time");
+          start_ns_ = start_ns_ < 0 ? start : std::min(start_ns_, start);
+        }
       }
       records.push_back(record);
     }
     if (!header_seen) throw InputError(path_, 0, 0, "no bag header record after the magic");
 
     // Pass 2: chunks in file order, each checked against the index data records that follow it.
+    // The next wanted compressed chunk is decompressed on another thread while this one is parsed
+    // (its errors surface when its turn comes, in file order).
     std::map<uint32_t, uint32_t> chunk_counts;
     bool chunk_read = false;
     size_t chunk_offset = 0;
-    for (const Record& record : records) {
+    std::future<std::string> next;
+    size_t next_index = records.size();
+    for (size_t i = 0; i < records.size(); ++i) {
+      const Record& record = records[i];
       if (record.op == kChunk) {
         chunk_counts.clear();
         chunk_offset = record.offset;
         chunk_read = Wanted(record.offset);
-        if (chunk_read) ReadChunk(record, &chunk_counts);
+        if (!chunk_read) continue;
+        std::string buffer = next_index == i ? next.get() : Inflate(record);
+        next_index = records.size();
+        size_t j = i + 1;
+        while (j < records.size() && records[j].op != kChunk) ++j;
+        if (j < records.size() && Wanted(records[j].offset) && records[j].fields.Get("compression") != "none") {
+          next = std::async(std::launch::async, [this, &records, j] { return Inflate(records[j]); });
+          next_index = j;
+        }
+        ReadChunk(record, buffer, &chunk_counts);
       } else if (record.op == kIndexData && chunk_read) {
         const uint32_t conn = FieldValue<uint32_t>(record, "conn", path_, "");
         const uint32_t count = FieldValue<uint32_t>(record, "count", path_, "");
@@ -189,6 +209,10 @@ class Ros1Reader {
         throw InputError(path_, 0, 0, fmt::format("message data record at byte {}: outside a chunk", record.offset));
       }
     }
+    // The start as rosbags gives it: the earliest chunk info start_time (without chunk infos, the
+    // earliest message of the chunks read, which are then all of them).
+    if (start_ns_ < 0) start_ns_ = first_message_ns_;
+    if (start_ns_ >= 0 && visitor_.on_start_time) visitor_.on_start_time(start_ns_);
   }
 
  private:
@@ -225,19 +249,24 @@ class Ros1Reader {
     wanted_[conn] = visitor_.on_connection(conn, connection);
   }
 
-  void ReadChunk(const Record& chunk, std::map<uint32_t, uint32_t>* counts) {
+  // A compressed chunk's records (empty for an uncompressed chunk, whose data is read in place).
+  std::string Inflate(const Record& chunk) const {
     const std::string what = fmt::format("chunk record at byte {}", chunk.offset);
     const std::string_view compression = chunk.fields.Get("compression");
     const uint32_t size = FieldValue<uint32_t>(chunk, "size", path_, "");
-    std::string buffer;
-    std::string_view content = chunk.data;
     if (compression != "none") {
-      buffer = Decompress(compression == "bz2" ? "bz2" : compression == "lz4" ? "lz4-frame" : compression, chunk.data,
-                          size, path_, what);
-      content = buffer;
-    } else if (chunk.data.size() != size) {
+      return Decompress(compression == "bz2" ? "bz2" : compression == "lz4" ? "lz4-frame" : compression, chunk.data,
+                        size, path_, what);
+    }
+    if (chunk.data.size() != size) {
       throw InputError(path_, 0, 0, fmt::format("{}: holds {} bytes, its header says {}", what, chunk.data.size(), size));
     }
+    return {};
+  }
+
+  // `buffer`: Inflate(chunk).
+  void ReadChunk(const Record& chunk, const std::string& buffer, std::map<uint32_t, uint32_t>* counts) {
+    const std::string_view content = chunk.fields.Get("compression") != "none" ? std::string_view(buffer) : chunk.data;
     const std::string where = fmt::format("chunk at byte {}: ", chunk.offset);
     RecordReader inner(content, 0, path_, where);
     while (!inner.done()) {
@@ -253,7 +282,9 @@ class Ros1Reader {
                                                     where, record.offset, conn));
         }
         ++(*counts)[conn];
-        if (it->second) visitor_.on_message(conn, TimeNs(record, path_, where), record.data);
+        const int64_t time = TimeNs(record, path_, where);
+        first_message_ns_ = first_message_ns_ < 0 ? time : std::min(first_message_ns_, time);
+        if (it->second) visitor_.on_message(conn, time, record.data);
       } else {
         throw InputError(path_, 0, 0, fmt::format("{}{} at byte {} (op {:#04x}): expected connection or message data "
                                                   "records inside a chunk",
@@ -266,6 +297,8 @@ class Ros1Reader {
   const Visitor& visitor_;
   std::unordered_map<uint32_t, bool> wanted_;  // connection -> messages wanted
   std::map<uint64_t, std::set<uint32_t>> chunk_connections_;
+  int64_t start_ns_ = -1;          // earliest chunk info start_time
+  int64_t first_message_ns_ = -1;  // earliest message read
 };
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "cheval/bag/bag.h"
 #include "cheval/common/output.h"
 #include "container.h"
+#include "container.h"
 
 namespace cheval::bag {
 namespace {
@@ -339,7 +340,16 @@ std::string WriteMcap(const std::vector<TopicToWrite>& topics, const WriteOption
 
 // ROS 2 ------------------------------------------------------------------------------------------
 
-void WriteRos2(const std::string& folder, const std::vector<TopicToWrite>& topics) {
+void WriteRos2(const std::string& folder, const std::vector<TopicToWrite>& topics, const WriteOptions& options) {
+  const bool zstd = options.compression == "zstd";
+  if (!zstd && options.compression != "none" && !options.compression.empty()) {
+    throw UsageError("WriteOptions::compression '" + options.compression + "' for ROS 2 is not one of none, zstd");
+  }
+  if (zstd && options.ros2_compression_mode != "file" && options.ros2_compression_mode != "message") {
+    throw UsageError("WriteOptions::ros2_compression_mode '" + options.ros2_compression_mode +
+                     "' is not one of file, message");
+  }
+  const bool per_message = zstd && options.ros2_compression_mode == "message";
   std::error_code error;
   std::filesystem::create_directories(folder, error);
   if (error) throw OutputError(fmt::format("{}: cannot create the folder: {}", folder, error.message()));
@@ -373,7 +383,8 @@ void WriteRos2(const std::string& folder, const std::vector<TopicToWrite>& topic
   std::unique_ptr<sqlite3_stmt, decltype(&sqlite3_finalize)> insert(statement, sqlite3_finalize);
   const std::vector<Entry> entries = InTimeOrder(topics);
   for (const Entry& e : entries) {
-    const std::string data = Serialize(topics[e.topic], e.index, true);
+    const std::string serialized = Serialize(topics[e.topic], e.index, true);
+    const std::string data = per_message ? Compress("zstd", serialized) : serialized;
     sqlite3_bind_int64(statement, 1, e.topic + 1);
     sqlite3_bind_int64(statement, 2, e.time);
     sqlite3_bind_blob(statement, 3, data.data(), static_cast<int>(data.size()), SQLITE_TRANSIENT);
@@ -381,10 +392,22 @@ void WriteRos2(const std::string& folder, const std::vector<TopicToWrite>& topic
     sqlite3_reset(statement);
   }
   exec("COMMIT;");
+  insert.reset();
+  db.reset();
+  std::string stored = db_name;
+  if (zstd && !per_message) {  // rosbag2's FILE mode: the database compressed whole, FILE.zstd
+    stored += ".zstd";
+    WriteOutput((std::filesystem::path(folder) / stored).string(), Compress("zstd", ReadFileBytes(db_path)));
+    std::filesystem::remove(db_path, error);
+  }
+  const int64_t first = entries.empty() ? 0 : entries.front().time;
+  const int64_t last = entries.empty() ? 0 : entries.back().time;
   const std::string yaml = fmt::format(
-      "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: sqlite3\n  compression_format: ''\n"
-      "  compression_mode: ''\n  relative_file_paths:\n  - {}\n  message_count: {}\n  topics_with_message_count:\n{}",
-      db_name, entries.size(), yaml_topics);
+      "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: sqlite3\n  compression_format: '{}'\n"
+      "  compression_mode: '{}'\n  relative_file_paths:\n  - {}\n  message_count: {}\n  starting_time:\n"
+      "    nanoseconds_since_epoch: {}\n  duration:\n    nanoseconds: {}\n  topics_with_message_count:\n{}",
+      zstd ? "zstd" : "", zstd ? (per_message ? "MESSAGE" : "FILE") : "", stored, entries.size(), first, last - first,
+      yaml_topics);
   WriteOutput((std::filesystem::path(folder) / "metadata.yaml").string(), yaml);
 }
 
@@ -395,7 +418,7 @@ void WriteBag(const std::string& path, const std::vector<TopicToWrite>& topics, 
   switch (options.container) {
     case Container::kRos1: WriteOutput(path, WriteRos1(topics, options)); return;
     case Container::kMcap: WriteOutput(path, WriteMcap(topics, options)); return;
-    case Container::kRos2: WriteRos2(path, topics); return;
+    case Container::kRos2: WriteRos2(path, topics, options); return;
     case Container::kNone: break;
   }
   throw UsageError("WriteOptions::container must be ros1, ros2 or mcap");

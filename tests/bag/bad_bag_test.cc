@@ -190,14 +190,23 @@ TEST_F(BadBag, Ros2FolderWithMissingDatabaseOrCompression) {
     std::ifstream in(folder + "/metadata.yaml");
     yaml.assign(std::istreambuf_iterator<char>(in), {});
   }
-  std::string compressed = yaml;
-  compressed.replace(compressed.find("compression_format: ''"), 22, "compression_format: zstd");
-  std::ofstream(folder + "/metadata.yaml") << compressed;
-  try {
-    ReadBagTrajectory(folder, {"/pose", false});
-    FAIL() << "no error";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("metadata.yaml:0:0: error: compression_format 'zstd'"), std::string::npos) << e.what();
+  // An unknown compression format, zstd without a mode, and zstd FILE over a plain database.
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"compression_format: lz4", "metadata.yaml:0:0: error: compression_format 'lz4': only zstd"},
+      {"compression_format: zstd", "metadata.yaml:0:0: error: compression_mode '': expected FILE or MESSAGE"},
+      {"compression_format: zstd\n  compression_mode: FILE\n  x: ''", "ros2_0.db3:0:0: error: the file (compression_mode "
+                                                                      "FILE): not zstd data"}};
+  for (const auto& [replacement, expected] : cases) {
+    std::string compressed = yaml;
+    compressed.replace(compressed.find("compression_format: ''"), 22, replacement);
+    compressed.replace(compressed.find("compression_mode: ''"), 20, "");
+    std::ofstream(folder + "/metadata.yaml") << compressed;
+    try {
+      ReadBagTrajectory(folder, {"/pose", false});
+      ADD_FAILURE() << "no error for " << replacement;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
   }
   std::ofstream(folder + "/metadata.yaml") << yaml;
   std::filesystem::remove(folder + "/ros2_0.db3");
@@ -208,6 +217,49 @@ TEST_F(BadBag, OtherRosbagVersionIsNamed) {
   const std::string path = Save("#ROSBAG V1.2\nwhatever");
   EXPECT_EQ(DetectContainer(path), Container::kRos1);
   EXPECT_NE(InputErrorOf(path).find("ROS 1 bag version 1.2"), std::string::npos);
+}
+
+TEST_F(BadBag, CorruptZstdInCompressedRos2FoldersIsNamed) {
+  for (const char* mode : {"file", "message"}) {
+    const std::string folder = Path(std::string("ros2_") + mode);
+    WriteOptions options;
+    options.container = Container::kRos2;
+    options.compression = "zstd";
+    options.ros2_compression_mode = mode;
+    WriteBag(folder, {{"/pose", MessageType::kPoseStamped, Poses(5)}}, options);
+    ASSERT_EQ(ReadBagTrajectory(folder, {"/pose", false}).size(), 5) << mode;
+    const std::string db = folder + "/ros2_" + mode + "_0.db3" + (std::string(mode) == "file" ? ".zstd" : "");
+    std::string bytes;
+    {
+      std::ifstream in(db, std::ios::binary);
+      bytes.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    if (std::string(mode) == "file") {
+      bytes.resize(bytes.size() / 2);  // a truncated frame
+    } else {
+      // The first message's zstd frame magic (28 B5 2F FD) broken.
+      const size_t magic = bytes.find("\x28\xb5\x2f\xfd");
+      ASSERT_NE(magic, std::string::npos);
+      bytes[magic + 1] = 'x';
+    }
+    std::ofstream(db, std::ios::binary | std::ios::trunc) << bytes;
+    // The error names the compressed database (FILE) or the database and the message (MESSAGE).
+    try {
+      ReadBagTrajectory(folder, {"/pose", false});
+      ADD_FAILURE() << "no error for " << mode;
+    } catch (const InputError& e) {
+      const std::string message = e.what();
+      const std::string expected = std::string(mode) == "file"
+                                       ? db + ":0:0: error: the file (compression_mode FILE): zstd data does not "
+                                              "decompress"
+                                       : db + ":0:0: error: message ";
+      EXPECT_EQ(message.find(expected), 0u) << message;
+      if (std::string(mode) == "message") {
+        EXPECT_NE(message.find("(compression_mode MESSAGE, log time "), std::string::npos) << message;
+        EXPECT_NE(message.find("not zstd data"), std::string::npos) << message;
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 // Recordings written by bag::WriteBag in every container, compression and encoding read back by
 // bag::ReadBagTrajectory / traj::ReadTrajectory: every message type, stamps from headers and from the
-// record time, Odometry twists turned into world-frame velocities, the last Path, tf chains.
+// record time, Odometry twists turned into world-frame velocities, the last Path (tf chains: tf_test.cc).
 #include <sys/stat.h>
 
 #include <cmath>
@@ -76,6 +76,7 @@ class RoundTrip : public ::testing::TestWithParam<Case> {
     options.container = std::get<0>(GetParam());
     options.compression = std::get<1>(GetParam());
     options.mcap_encoding = std::get<2>(GetParam());
+    if (options.container == Container::kRos2) options.ros2_compression_mode = std::get<2>(GetParam());
     options.messages_per_chunk = 7;  // several chunks
     const std::string path = dir / (options.container == Container::kRos2 ? "bag" : "bag.bin");
     WriteBag(path, topics, options);
@@ -144,94 +145,18 @@ TEST_P(RoundTrip, TopicsAreListedWithCounts) {
   EXPECT_EQ(topics[1].count, 9);
 }
 
-TEST_P(RoundTrip, TfChainThroughStaticAndDynamicEdgesInterpolated) {
-  TempDir dir;
-  // odom -> base_footprint dynamic at 10 Hz; base_footprint -> base_link static (a 0.3 m lift, a
-  // quarter turn about x); odom -> camera dynamic at 2 Hz, on another branch of the tree.
-  std::vector<PoseMessage> footprint = Helix(21);
-  for (PoseMessage& m : footprint) m.frame_id = "odom", m.child_frame_id = "base_footprint";
-  PoseMessage link;
-  link.stamp_ns = footprint.front().stamp_ns;
-  link.record_time_ns = footprint.front().record_time_ns;
-  link.frame_id = "base_footprint";
-  link.child_frame_id = "base_link";
-  link.position[2] = 0.3;
-  link.orientation[0] = std::sin(M_PI / 4);
-  link.orientation[3] = std::cos(M_PI / 4);
-  std::vector<PoseMessage> tf = footprint;
-  std::vector<PoseMessage> camera;
-  for (int i = 0; i < 5; ++i) {  // 0.5 s apart: the footprint stamps between are interpolated
-    PoseMessage m;
-    m.stamp_ns = footprint.front().stamp_ns + i * 500000000LL;
-    m.record_time_ns = m.stamp_ns;
-    m.frame_id = "odom";
-    m.child_frame_id = "camera";
-    m.position[0] = 2.0 * i;  // moves 4 m/s along x
-    tf.push_back(m);
-    camera.push_back(m);
-  }
-  const std::string path = Write(dir, {{"/tf", MessageType::kTfMessage, tf}, {"/tf_static", MessageType::kTfMessage, {link}}});
-
-  const traj::Trajectory base_link = ReadBagTrajectory(path, {"/tf:odom.base_link", false});
-  ASSERT_EQ(base_link.size(), 21);
-  for (Eigen::Index i = 0; i < 21; ++i) {
-    const PoseMessage& f = footprint[static_cast<size_t>(i)];
-    EXPECT_EQ(base_link.stamps_ns()[i], f.stamp_ns);
-    EXPECT_NEAR(base_link.positions()(0, i), f.position[0], 1e-12);
-    EXPECT_NEAR(base_link.positions()(2, i), f.position[2] + 0.3, 1e-12);  // the lift is vertical
-    const Eigen::Quaterniond expected = Eigen::Quaterniond(f.orientation[3], 0, 0, f.orientation[2]) *
-                                        Eigen::Quaterniond(link.orientation[3], link.orientation[0], 0, 0);
-    EXPECT_NEAR(std::abs(base_link.View().UnitQuaternion(i).dot(expected)), 1.0, 1e-12);
-  }
-  // camera in base_footprint, up through odom and down the other branch, at the camera's stamps.
-  const traj::Trajectory cam = ReadBagTrajectory(path, {"/tf:base_footprint.camera", false});
-  ASSERT_EQ(cam.size(), 5);
-  // At 0.5 s the footprint pose (index 5) is interpolation-free: compare with the inverse composition.
-  const PoseMessage& f5 = footprint[5];
-  const Eigen::Quaterniond q5(f5.orientation[3], 0, 0, f5.orientation[2]);
-  const Eigen::Vector3d expected = q5.conjugate() * (Eigen::Vector3d(2.0, 0, 0) -
-                                                     Eigen::Vector3d(f5.position[0], f5.position[1], f5.position[2]));
-  EXPECT_NEAR((cam.positions().col(1) - expected).norm(), 0.0, 1e-12);
-  const traj::Trajectory odom_cam = ReadBagTrajectory(path, {"/tf:odom.camera", false});
-  EXPECT_EQ(odom_cam.size(), 5);
-}
-
 INSTANTIATE_TEST_SUITE_P(
     Containers, RoundTrip,
     ::testing::Values(Case{Container::kRos1, "none", "cdr"}, Case{Container::kRos1, "bz2", "cdr"},
                       Case{Container::kRos1, "lz4", "cdr"}, Case{Container::kMcap, "none", "cdr"},
                       Case{Container::kMcap, "zstd", "cdr"}, Case{Container::kMcap, "lz4", "cdr"},
                       Case{Container::kMcap, "zstd", "ros1"}, Case{Container::kMcap, "none", "ros1"},
-                      Case{Container::kRos2, "none", "cdr"}),
+                      Case{Container::kRos2, "none", "cdr"}, Case{Container::kRos2, "zstd", "file"},
+                      Case{Container::kRos2, "zstd", "message"}),
     [](const ::testing::TestParamInfo<Case>& param) {
       return std::string(ToString(std::get<0>(param.param))) + "_" + std::get<1>(param.param) + "_" +
              std::get<2>(param.param);
     });
-
-TEST(TfChain, InterpolatesBetweenStampsOfAnotherEdge) {
-  TempDir dir;
-  // odom -> a at t = 0, 1 s (moving 0 -> 1 m in x); a -> b at t = 0.25 s only... and 0.75 s: b's
-  // stamps lie between a's, so a's edge is interpolated at 0.25 and 0.75 s.
-  auto tf = [](int64_t t, const char* parent, const char* child, double x) {
-    PoseMessage m;
-    m.stamp_ns = t;
-    m.record_time_ns = t;
-    m.frame_id = parent;
-    m.child_frame_id = child;
-    m.position[0] = x;
-    return m;
-  };
-  const int64_t s = 1000000000;
-  const std::vector<PoseMessage> messages = {tf(0, "odom", "a", 0.0), tf(s / 4, "a", "b", 10.0),
-                                             tf(3 * s / 4, "a", "b", 20.0), tf(s, "odom", "a", 1.0)};
-  const std::string path = dir / "tf.bag";
-  WriteBag(path, {{"/tf", MessageType::kTfMessage, messages}});
-  const traj::Trajectory t = ReadBagTrajectory(path, {"/tf:odom.b", false});
-  ASSERT_EQ(t.size(), 2);
-  EXPECT_EQ(t.stamps_ns()[0], s / 4);
-  EXPECT_NEAR(t.positions()(0, 0), 10.25, 1e-12);
-  EXPECT_NEAR(t.positions()(0, 1), 20.75, 1e-12);
-}
 
 }  // namespace
 }  // namespace cheval::bag

@@ -66,25 +66,6 @@ TEST(SharedBags, RosExampleApeEqualsTheExportedTumFiles) {
   }
 }
 
-TEST(SharedBags, TfExampleRos1AndRos2GiveTheSameChains) {
-  CHEVAL_REQUIRE_SHARED_DATA();
-  for (const char* chain : {"/tf:odom.base_link", "/tf:odom.base_footprint"}) {
-    const traj::Trajectory ros1 = ReadBagTrajectory(Evo("tf_example.bag"), {chain, false});
-    const traj::Trajectory ros2 = ReadBagTrajectory(Evo("tf_example"), {chain, false});
-    ASSERT_EQ(ros1.size(), 517) << chain;
-    ASSERT_EQ(ros2.size(), 517) << chain;
-    EXPECT_EQ(ros1.stamps_ns().front(), 1714741164177519307LL);
-    EXPECT_EQ(ros1.stamps_ns().back(), 1714741215784817334LL);
-    EXPECT_TRUE(std::equal(ros1.stamps_ns().begin(), ros1.stamps_ns().end(), ros2.stamps_ns().begin()));
-    EXPECT_EQ(ros1.raw_positions(), ros2.raw_positions());
-    EXPECT_EQ(ros1.raw_orientations(), ros2.raw_orientations());
-  }
-  // base_footprint -> base_link is a static identity: both chains are the same poses.
-  const traj::Trajectory link = ReadBagTrajectory(Evo("tf_example"), {"/tf:odom.base_link", false});
-  const traj::Trajectory footprint = ReadBagTrajectory(Evo("tf_example"), {"/tf:odom.base_footprint", false});
-  EXPECT_EQ(link.raw_positions(), footprint.raw_positions());
-}
-
 TEST(SharedBags, Nav2McapCountsStampsAndOdometryVelocity) {
   CHEVAL_REQUIRE_SHARED_DATA();
   const std::vector<TopicInfo> topics = ListTopics(Evo("nav2_turtlebot.mcap"));

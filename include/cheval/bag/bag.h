@@ -102,9 +102,11 @@ struct TopicToWrite {
 /// How to write a recording.
 struct WriteOptions {
   Container container = Container::kRos1;
-  /// Compression of the chunks: "none", "bz2" or "lz4" (ROS 1), "none", "zstd" or "lz4" (MCAP); ROS 2
-  /// folders are never compressed.
+  /// Compression of the chunks: "none", "bz2" or "lz4" (ROS 1), "none", "zstd" or "lz4" (MCAP); of a
+  /// ROS 2 folder: "none" or "zstd" (see `ros2_compression_mode`).
   std::string compression = "none";
+  /// ROS 2 with "zstd": "file" (the .db3 stored as .db3.zstd) or "message" (each message compressed).
+  std::string ros2_compression_mode = "file";
   /// MCAP only: "cdr" or "ros1" message encoding.
   std::string mcap_encoding = "cdr";
   /// Messages per chunk (ROS 1, MCAP).
