@@ -671,7 +671,10 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   // (boundary, is a jump) in the fitted numbering, ascending.
   std::vector<std::pair<Eigen::Index, bool>> boundaries;
   auto add_boundary = [&](Eigen::Index b, bool jump) {
-    const Eigen::Index last_kept = fitted_index[static_cast<size_t>(b)] + kept[static_cast<size_t>(b)] - 1;
+    Eigen::Index last_kept = fitted_index[static_cast<size_t>(b)] + kept[static_cast<size_t>(b)] - 1;
+    // Samples at one stamp stay in one segment (segments must not share a time): a jump found
+    // between two of them moves past the last.
+    while (last_kept >= 0 && last_kept + 1 < fitted_count && t[last_kept + 1] == t[last_kept]) ++last_kept;
     if (last_kept >= 0 && last_kept + 1 < fitted_count) boundaries.emplace_back(last_kept, jump);
   };
   for (const Eigen::Index b : gaps) add_boundary(b, false);
