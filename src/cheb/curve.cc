@@ -762,8 +762,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     Eigen::MatrixXd fit_values, fit_rates;
     curve.EvaluateMany(sorted, 1, &fit_values, &fit_rates);
     for (Eigen::Index i = 0; i < fitted_count; ++i) {  // the fitted values without the steps, as z
-      const auto k = std::upper_bound(curve.step_times_.begin(), curve.step_times_.end(), t[i]) - curve.step_times_.begin();
-      if (k > 0) fit_values.row(i) -= curve.step_offsets_.row(k - 1);
+      if (const Eigen::Index k = curve.StepsBefore(t[i]); k > 0) fit_values.row(i) -= curve.step_offsets_.row(k - 1);
     }
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
       std::vector<LocalRun> runs = internal::LocalRuns(t, z, starts[k], starts[k + 1], curve.segments_[k], fit_values,
@@ -798,10 +797,13 @@ void Curve::EvaluateVelocity(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value
   EvaluateUpTo(stamp_ns, 1, value, &derivative, nullptr, tolerance_s);
 }
 
+Eigen::Index Curve::StepsBefore(double t) const {
+  return std::upper_bound(step_times_.begin(), step_times_.end(), t) - step_times_.begin();
+}
+
 template <typename Row>
 void Curve::AddSteps(double t, Row&& value) const {
-  const auto k = std::upper_bound(step_times_.begin(), step_times_.end(), t) - step_times_.begin();
-  if (k > 0) value += step_offsets_.row(k - 1);
+  if (const Eigen::Index k = StepsBefore(t); k > 0) value += step_offsets_.row(k - 1);
 }
 
 Curve::Placement Curve::Locate(double t, double tolerance_s) const {
@@ -879,22 +881,23 @@ void Curve::EvaluateUpTo(int64_t stamp_ns, int order, Eigen::Ref<Eigen::VectorXd
                          Eigen::Ref<Eigen::VectorXd>* derivative, Eigen::Ref<Eigen::VectorXd>* second_derivative,
                          double tolerance_s) const {
   const double t = static_cast<double>(stamp_ns - origin_ns_) * 1e-9;
-  const Placement placement = Locate(t, tolerance_s);
   Point p, v, a;
-  EvaluateWindow(*placement.left, t, order, &p, &v, &a);
-  if (placement.right != nullptr) {
-    // The blend's derivatives need both windows' values and lower derivatives.
-    Point pr, vr, ar;
-    EvaluateWindow(*placement.right, t, order, &pr, &vr, &ar);
-    const double s = placement.s, ds = placement.ds, dds = placement.dds;
-    if (order >= 2) a = (1.0 - s) * a + s * ar + 2.0 * ds * (vr - v) + dds * (pr - p);
-    if (order >= 1) v = (1.0 - s) * v + s * vr + ds * (pr - p);
-    p = (1.0 - s) * p + s * pr;
-  }
-  if (const LocalRun* run = LocalRunAt(t)) {
+  if (const LocalRun* run = LocalRunAt(t)) {  // the run's, no window evaluated
     Eigen::RowVectorXd lp(dimension_), lv(dimension_), la(dimension_);
     EvaluateLocal(*run, t, order, lp, lv, la);
     p = lp.transpose(), v = lv.transpose(), a = la.transpose();
+  } else {
+    const Placement placement = Locate(t, tolerance_s);
+    EvaluateWindow(*placement.left, t, order, &p, &v, &a);
+    if (placement.right != nullptr) {
+      // The blend's derivatives need both windows' values and lower derivatives.
+      Point pr, vr, ar;
+      EvaluateWindow(*placement.right, t, order, &pr, &vr, &ar);
+      const double s = placement.s, ds = placement.ds, dds = placement.dds;
+      if (order >= 2) a = (1.0 - s) * a + s * ar + 2.0 * ds * (vr - v) + dds * (pr - p);
+      if (order >= 1) v = (1.0 - s) * v + s * vr + ds * (pr - p);
+      p = (1.0 - s) * p + s * pr;
+    }
   }
   value = p;
   AddSteps(t, value.transpose());
@@ -917,9 +920,12 @@ void Curve::EvaluateMany(std::span<const int64_t> stamps_ns, int order, Eigen::M
   }
   std::vector<double> t(static_cast<size_t>(n));
   std::vector<Placement> placements(static_cast<size_t>(n));
+  // A query inside a local run is the run's (no window is evaluated for it).
+  std::vector<const LocalRun*> local(static_cast<size_t>(n));
   for (Eigen::Index r = 0; r < n; ++r) {
     t[r] = static_cast<double>(stamps_ns[sorted[r]] - origin_ns_) * 1e-9;
-    placements[r] = Locate(t[r], tolerance_s);
+    local[r] = LocalRunAt(t[r]);
+    if (local[r] == nullptr) placements[r] = Locate(t[r], tolerance_s);
   }
   // Each window evaluated at a run of queries at once (vectorised Clenshaw), for the left and the
   // right window of every query: (order + 1) blocks of n x d each.
@@ -955,9 +961,9 @@ void Curve::EvaluateMany(std::span<const int64_t> stamps_ns, int order, Eigen::M
   for (Eigen::Index r = 0; r < n; ++r) {
     const Placement& q = placements[r];
     const Eigen::Index i = sorted[r];
-    if (const LocalRun* run = LocalRunAt(t[r])) {
+    if (local[r] != nullptr) {
       Eigen::RowVectorXd p(d), v(d), a(d);
-      EvaluateLocal(*run, t[r], order, p, v, a);
+      EvaluateLocal(*local[r], t[r], order, p, v, a);
       values->row(i) = p;
       AddSteps(t[r], values->row(i));
       if (order >= 1) first->row(i) = v;

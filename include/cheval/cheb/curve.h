@@ -222,6 +222,8 @@ class Curve {
   std::vector<double> outlier_times_, jump_times_, step_times_;
   // Row k: the sum of the first k + 1 steps, added to values after step_times_[k].
   Eigen::MatrixXd step_offsets_;
+  // How many steps lie before time t (row StepsBefore(t) - 1 of step_offsets_ is their sum).
+  Eigen::Index StepsBefore(double t) const;
   // Adds the steps before time t to a value.
   template <typename Row>
   void AddSteps(double t, Row&& value) const;
