@@ -9,6 +9,7 @@
 #include "cheval/bag/bag.h"
 #include "cheval/common/error.h"
 #include "cheval/traj/io.h"
+#include "../support/test_data.h"
 
 namespace cheval::bag {
 namespace {
@@ -16,11 +17,7 @@ namespace {
 class BadBag : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("cheval_bad_bag_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(::getpid()));
-    std::filesystem::remove_all(dir_);
-    std::filesystem::create_directories(dir_);
+    dir_ = testing::FreshTestDir("cheval_bad_bag_");
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 

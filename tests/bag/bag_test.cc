@@ -14,6 +14,7 @@
 #include "cheval/bag/bag.h"
 #include "cheval/common/error.h"
 #include "cheval/traj/io.h"
+#include "../support/test_data.h"
 
 namespace cheval::bag {
 namespace {
@@ -22,11 +23,7 @@ namespace {
 class TempDir {
  public:
   TempDir() {
-    path_ = std::filesystem::temp_directory_path() /
-            ("cheval_bag_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-             std::to_string(::getpid()));
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
+    path_ = testing::FreshTestDir("cheval_bag_");
   }
   ~TempDir() { std::filesystem::remove_all(path_); }
   std::string operator/(const std::string& name) const { return (path_ / name).string(); }

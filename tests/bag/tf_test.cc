@@ -3,7 +3,6 @@
 // lookup times (the recording's start, every 0.1 s, up to the latest common time), the times
 // skipped (before an edge's first transform), the static transform (the last one), the static-only
 // chain (one pose at stamp 0), interpolation between transforms; and the shared evo bags.
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -16,6 +15,7 @@
 #include "cheval/common/error.h"
 #include "tf.h"
 #include "tf_buffer.h"
+#include "../support/test_data.h"
 
 #ifndef CHEVAL_DATA_DIR
 #define CHEVAL_DATA_DIR ""
@@ -41,11 +41,7 @@ PoseMessage Tf(int64_t stamp, const char* parent, const char* child, double x, d
 class TfEvo : public ::testing::TestWithParam<std::tuple<Container, std::string>> {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("cheval_tf_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(::getpid()));
-    std::filesystem::remove_all(dir_);
-    std::filesystem::create_directories(dir_);
+    dir_ = testing::FreshTestDir("cheval_tf_");
     // odom -> base every 0.2 s from 100.3 s to 101.5 s, x = 10 (t - 100); base -> lidar at 100.0,
     // 100.5, 101.0 s; base -> cam static, written twice (z = 1, then z = 2). A marker on /m is the
     // recording's first message (100 s + 7 ns), so the lookup times are 100.000000007 + k 0.1 s.

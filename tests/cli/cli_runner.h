@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/test_data.h"
+
 namespace cheval::testing {
 
 struct RunResult {
@@ -30,11 +32,7 @@ inline std::string Slurp(const std::filesystem::path& path) {
 class CliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("cheval_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(::getpid()));
-    std::filesystem::remove_all(dir_);
-    std::filesystem::create_directories(dir_);
+    dir_ = FreshTestDir("cheval_cli_");
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 

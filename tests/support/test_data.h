@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <string>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 namespace cheval::testing {
@@ -16,6 +18,17 @@ inline std::string FixturePath(const std::string& relative) { return std::string
 inline std::string SharedDataDir() {
   const char* env = std::getenv("CHEVAL_DATA_DIR");
   return env != nullptr && *env != '\0' ? std::string(env) : std::string(CHEVAL_DATA_DIR);
+}
+
+/// An empty folder of the running test's own: temp/PREFIX<test name>_<pid>, whatever an earlier run
+/// left there removed first. The caller removes it when done.
+inline std::filesystem::path FreshTestDir(const std::string& prefix) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() /
+      (prefix + ::testing::UnitTest::GetInstance()->current_test_info()->name() + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
 }
 
 inline bool InCi() {

@@ -15,6 +15,7 @@
 #include "cheval/common/error.h"
 #include "cheval/traj/io.h"
 #include "cheval/traj/validate.h"
+#include "../support/test_data.h"
 
 namespace cheval::traj {
 namespace {
@@ -41,10 +42,7 @@ std::string ReadError(const std::string& path, const ReadOptions& options = {}) 
 class TempFolder : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("cheval_validate_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(::getpid()));
-    std::filesystem::create_directories(dir_);
+    dir_ = testing::FreshTestDir("cheval_validate_");
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
   std::string Write(const std::string& name, const std::string& text) const {
