@@ -175,6 +175,25 @@ Eigen::Matrix<double, 12, 1> CollocationSigma(const RotorEstimateOptions& o) {
   return sigma;
 }
 
+// The collocation defects at every node: p' and R' by the model's kinematics (CollocationCost), v'
+// and ω' by ParametricCollocationCost (the rotor accelerations; θ a parameter block when kIdentify,
+// else the values `theta` points to).
+template <bool kIdentify>
+void AddDynamics(Problem& problem, const RotorModel& model, const RotorEstimateOptions& o, double* theta) {
+  const Eigen::MatrixXd D = cheb::DifferentiationMatrix(o.degree);
+  const Eigen::Matrix<double, 12, 1> sigma = CollocationSigma(o);
+  using Dynamics = internal::ParametricCollocationCost<kIdentify>;
+  for (int s = 0; s < problem.num_segments(); ++s) {
+    const internal::Segment segment = problem.SegmentOf(s);
+    for (int j = 0; j <= o.degree; ++j) {
+      problem.AddPrior(std::make_unique<internal::CollocationCost<RotorModel>>(model, segment, D, j, 0, sigma));
+      problem.AddPrior(std::make_unique<internal::CollocationCost<RotorModel>>(model, segment, D, j, 3, sigma));
+      problem.AddPrior(std::make_unique<Dynamics>(model.nominal, segment, D, j, 1, o.sigma_acceleration, theta));
+      problem.AddPrior(std::make_unique<Dynamics>(model.nominal, segment, D, j, 2, o.sigma_angular_acceleration, theta));
+    }
+  }
+}
+
 ceres::Solver::Options SolverOptions(const RotorEstimateOptions& o) {
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
@@ -222,7 +241,8 @@ RotorEstimate EstimateRotors(const RotorFlight& flight, const RotorVehicle& vehi
   out.converged = true;
   for (const auto& [first, last] : spans) {
     std::unique_ptr<Problem> problem = BuildProblem(flight, first, last, model, o, false, &huber);
-    problem->AddCollocation(CollocationSigma(o));
+    RotorThetaVector theta = vehicle.theta;
+    AddDynamics<false>(*problem, model, o, theta.data());
     problem->AddControlSmoothnessPrior(1, o.sigma_rotor_rate);
     const ceres::Solver::Summary summary = problem->Solve(SolverOptions(o));
     out.converged = out.converged && summary.termination_type == ceres::CONVERGENCE;
@@ -273,23 +293,11 @@ RotorIdentification IdentifyOne(const RotorFlight& flight, const RotorVehicle& b
   // One problem per span, all sharing θ: the spans' residuals go into the first problem's Ceres problem
   // only when there is one span; with several, each is solved in turn with θ carried over.
   RotorIdentification id;
-  const Eigen::MatrixXd D = cheb::DifferentiationMatrix(o.degree);
-  const Eigen::Matrix<double, 12, 1> sigma = CollocationSigma(o);
   double cost = 0;
   int residuals = 0, parameters = 0;
   for (const auto& [first, last] : Spans(flight, o.score_margin_s)) {
     std::unique_ptr<Problem> problem = BuildProblem(flight, first, last, model, o, true, &huber);
-    for (int s = 0; s < problem->num_segments(); ++s) {
-      const internal::Segment segment = problem->SegmentOf(s);
-      for (int j = 0; j <= o.degree; ++j) {
-        problem->AddPrior(std::make_unique<internal::CollocationCost<RotorModel>>(model, segment, D, j, 0, sigma));
-        problem->AddPrior(std::make_unique<internal::CollocationCost<RotorModel>>(model, segment, D, j, 3, sigma));
-        problem->AddPrior(std::make_unique<internal::ParametricCollocationCost>(
-            base.nominal, segment, D, j, 1, o.sigma_acceleration, theta.data()));
-        problem->AddPrior(std::make_unique<internal::ParametricCollocationCost>(
-            base.nominal, segment, D, j, 2, o.sigma_angular_acceleration, theta.data()));
-      }
-    }
+    AddDynamics<true>(*problem, model, o, theta.data());
     problem->AddPrior(std::make_unique<ThetaPrior>(theta.data(), RotorNominal::PublishedTheta(), PriorSigma()));
     for (int i = 0; i < 3; ++i) {  // a rigid body's inertia is positive: at least 1 % of the published one
       problem->ceres_problem().SetParameterLowerBound(theta.data(), kThetaInertiaX + i, 0.01);

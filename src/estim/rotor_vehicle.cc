@@ -134,6 +134,8 @@ std::string RotorVehicleToJson(const RotorVehicle& v) {
                              "N m/((rad/s)(m/s))"));
   params.push_back(Parameter("rotor_moment_y", kRotorFlapUnit * t[kThetaFlapX + 1],
                              kRotorFlapUnit * s[kThetaFlapX + 1], 0, "N m/((rad/s)(m/s))"));
+  params.push_back(Parameter("rotor_inertia", kRotorInertiaUnit * t[kThetaRotorInertia],
+                             kRotorInertiaUnit * s[kThetaRotorInertia], 0, "kg m^2"));
   for (json& p : params) {
     if (std::isnan(p["sigma"].get<double>())) p["sigma"] = nullptr;
   }

@@ -75,8 +75,54 @@ TEST(RotorModel, MatchesTheQuadrotorModel) {
   const Eigen::Vector4d rotors(1100, 1180, 1050, 1230);
   full.Dynamics(x, R, rotors.data(), x_dot, omega);
   const Eigen::Vector4d cf = ToCrazyflie(rotors);
-  estim::RotorDynamics(v.nominal, x, R, cf.data(), v.theta.data(), y_dot);
+  const double cf_dot[4] = {300, -120, 45, -800};  // no rotor inertia in θ: the rates play no part
+  estim::RotorDynamics(v.nominal, x, R, cf.data(), cf_dot, v.theta.data(), y_dot);
   for (int i = 0; i < 9; ++i) EXPECT_NEAR(y_dot[i], x_dot[i], 1e-9 * (1 + std::abs(x_dot[i]))) << i;
+}
+
+// The rotors' reaction torque conserves angular momentum: with every external torque and force zero
+// (θ's thrust and moment coefficients 0), a body whose rotors spin up and down keeps the world-frame
+// angular momentum R (J ω + h), h = −c_r Y e3 (Y = Σ s_i Ω_i) — its sign and gyroscopic part right.
+TEST(RotorModel, RotorReactionConservesAngularMomentum) {
+  estim::RotorVehicle v = SimRotorVehicle();
+  v.nominal.inertia_kgm2 = Eigen::Vector3d(2.4e-5, 2.6e-5, 4.1e-5);
+  estim::RotorThetaVector theta = estim::RotorThetaVector::Zero();
+  theta.segment<3>(estim::kThetaInertiaX).setOnes();
+  theta[estim::kThetaRotorInertia] = -30;  // c_r = −3e-8 kg m²
+  const double c_r = -30 * estim::kRotorInertiaUnit;
+  const Eigen::Vector3d J = v.nominal.inertia_kgm2;
+  const Eigen::Vector4d u0(1700, 1650, 1800, 1600), rate(900, -1500, 2500, -400);  // rad/s, rad/s²
+  const auto momentum = [&](const Eigen::Matrix3d& R, const Eigen::Vector3d& w, double t) {
+    const Eigen::Vector4d u = u0 + rate * t;
+    const double Y = u[0] - u[1] + u[2] - u[3];
+    return Eigen::Vector3d(R * (J.cwiseProduct(w) - c_r * Y * Eigen::Vector3d::UnitZ()));
+  };
+  // ω' of the model at (R, ω, t); p and v do not enter the torques here.
+  const auto w_dot = [&](const Eigen::Matrix3d& R, const Eigen::Vector3d& w, double t) {
+    const Eigen::Vector4d u = u0 + rate * t;
+    double x[9] = {0, 0, 0, 0, 0, 0, w.x(), w.y(), w.z()}, x_dot[9];
+    estim::RotorDynamics(v.nominal, x, R, u.data(), rate.data(), theta.data(), x_dot);
+    return Eigen::Vector3d(x_dot[6], x_dot[7], x_dot[8]);
+  };
+  Eigen::Matrix3d R = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, -1).normalized()).toRotationMatrix();
+  Eigen::Vector3d w(1.5, -2.0, 0.7);
+  const Eigen::Vector3d L0 = momentum(R, w, 0);
+  const double h = 1e-5;
+  const auto exp = [](const Eigen::Vector3d& phi) {
+    return phi.norm() > 0 ? Eigen::AngleAxisd(phi.norm(), phi.normalized()).toRotationMatrix()
+                          : Eigen::Matrix3d::Identity();
+  };
+  for (int k = 0; k < 20000; ++k) {  // 0.2 s by the midpoint rule on (R, ω)
+    const double t = k * h;
+    const Eigen::Vector3d w_mid = w + 0.5 * h * w_dot(R, w, t);
+    const Eigen::Matrix3d R_mid = R * exp(0.5 * h * w);
+    w += h * w_dot(R_mid, w_mid, t + 0.5 * h);
+    R = R * exp(h * w_mid);
+  }
+  const Eigen::Vector3d L1 = momentum(R, w, 20000 * h);
+  // The rotors' momentum changes by |c_r ΔY| = 3e-8 · 0.2 · 5300 ≈ 3.2e-5; the body takes it all.
+  EXPECT_LT((L1 - L0).norm(), 1e-3 * std::abs(c_r * 0.2 * 5300)) << (L1 - L0).transpose();
+  EXPECT_GT((J.cwiseProduct(w) - J.cwiseProduct(Eigen::Vector3d(1.5, -2.0, 0.7))).norm(), 0.3 * std::abs(c_r * 0.2 * 5300));
 }
 
 // The flatness inversion with the true vehicle on exact data is close (the fits' window smooths).

@@ -123,7 +123,7 @@ void RegisterIdentifyRotors(CLI::App& app, Action* action) {
       const char* names[] = {"k_m1/k_F", "k_m2/k_F", "k_m3/k_F", "k_m4/k_F", "Jx/Jx_pub", "Jy/Jy_pub",
                              "Jz/Jz_pub", "k_M/Kc", "tau0_x [1e-5 N m]", "tau0_y [1e-5 N m]",
                              "tau0_z [1e-5 N m]", "drag_xy [1e-5]", "drag_z [1e-5]", "moment_x [1e-8]",
-                             "moment_y [1e-8]"};
+                             "moment_y [1e-8]", "rotor_inertia [1e-9 kg m^2]"};
       for (int i = 0; i < estim::kRotorThetaSize; ++i) {
         fmt::print("{:<20}{:>10.4f} +- {:.4f}   (published {})\n", names[i], out.theta[i], out.theta_sigma[i],
                    estim::RotorNominal::PublishedTheta()[i]);

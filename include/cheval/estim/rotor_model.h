@@ -9,7 +9,8 @@
 /// (−1, −1), (−1, +1), (+1, +1) for m1..m4 (body x forward, y left, z up), yaw sign s = (+1, −1, +1, −1):
 ///
 ///   f_i = k_i Ω_i²,  T = Σ f_i,  τ = (l(−f1 − f2 + f3 + f4), l(−f1 + f2 + f3 − f4), k_M Σ s_i Ω_i²) + τ0
-///        + (Σ Ω_i) (b_x v_y, −b_y v_x, 0)   (v_x, v_y: body-frame velocity),
+///        + (Σ Ω_i) (b_x v_y, −b_y v_x, 0)   (v_x, v_y: body-frame velocity)
+///        + c_r (ω_y Y, −ω_x Y, Y')   (Y = Σ s_i Ω_i: the rotors' reaction, below),
 ///   p' = v,  R' = R[ω]×,  v' = g + R (T/m e3 − (Σ Ω_i) diag(d_xy, d_xy, d_z) Rᵀ v),
 ///   ω' = J⁻¹(τ − ω × Jω),  g = (0, 0, −|g|).
 ///
@@ -20,8 +21,12 @@
 /// flapping and induced drag, proportional to Σ Ω_i and the body-frame velocity (Mahony, Kumar &
 /// Corke 2012, "Multirotor aerial vehicles", §IV) — and the rotor moment of the same flapping, which
 /// tilts the rotor discs away from the horizontal airspeed (nose up in forward flight). On the
-/// Crazyflie flights the last one explains 80–90 % of the variance of the roll and pitch rotor-speed
-/// differences, the angular acceleration a few % (docs/estimator_real_data.md).
+/// Crazyflie flights the rotor moment explains 80–90 % of the variance of the roll and pitch
+/// rotor-speed differences, the angular acceleration a few % (docs/estimator_real_data.md). The
+/// rotors' own angular momentum h = −c_r Y e3 (c_r = −I_r times the spin sign of the motors with s = +1)
+/// gives the body the reaction −h' − ω × h: the torque of spinning the rotors up and down, by which a
+/// quadrotor yaws as much as by the rotors' drag torque k_M Ω² (on the Crazyflie flights the yaw
+/// acceleration's variance explained by the drag torque alone is 13–63 %, with the reaction 62–83 %).
 ///
 /// θ is held in units where the published vehicle is θ = (1, 1, 1, 1, 1, 1, 1, 1, 0, ..., 0)
 /// (then zeros), which keeps the solver's steps well scaled (the raw values span 1e-12 .. 1e-5).
@@ -42,7 +47,8 @@ enum RotorTheta : int {
   kThetaDragXY = 11,   ///< d_xy in units of kRotorDragUnit
   kThetaDragZ = 12,    ///< d_z in units of kRotorDragUnit
   kThetaFlapX = 13,    ///< rotor moment b_x in units of kRotorFlapUnit (and Y next)
-  kRotorThetaSize = 15
+  kThetaRotorInertia = 15,  ///< c_r in units of kRotorInertiaUnit (sign: the spin directions')
+  kRotorThetaSize = 16
 };
 
 /// The unit of τ0 in θ, N m (about 1 % of a hover rotor's roll torque on a Crazyflie).
@@ -51,6 +57,9 @@ inline constexpr double kRotorTorqueUnit = 1e-5;
 inline constexpr double kRotorDragUnit = 1e-5;
 /// The unit of the rotor-moment coefficients in θ, N m per (rad/s · m/s).
 inline constexpr double kRotorFlapUnit = 1e-8;
+
+/// The unit of the rotor-inertia coefficient c_r in θ, kg m² (a few % of a nano-quadrotor's yaw inertia).
+inline constexpr double kRotorInertiaUnit = 1e-9;
 
 using RotorThetaVector = Eigen::Matrix<double, kRotorThetaSize, 1>;
 
@@ -71,11 +80,11 @@ struct RotorNominal {
   }
 };
 
-/// p', v', ω' of the model above at state x = (p, v, ω), rotation R, rotor speeds u (m1..m4, rad/s)
-/// and parameters θ (any scalar types, for ceres::Jet).
+/// p', v', ω' of the model above at state x = (p, v, ω), rotation R, rotor speeds u and their
+/// derivatives u_dot (m1..m4, rad/s and rad/s²) and parameters θ (any scalar types, for ceres::Jet).
 template <typename T, typename P>
-void RotorDynamics(const RotorNominal& n, const T* x, const Eigen::Matrix<T, 3, 3>& R, const T* u, const P* theta,
-                   T* x_dot) {
+void RotorDynamics(const RotorNominal& n, const T* x, const Eigen::Matrix<T, 3, 3>& R, const T* u, const T* u_dot,
+                   const P* theta, T* x_dot) {
   using Vec = Eigen::Matrix<T, 3, 1>;
   const Vec v(x[3], x[4], x[5]), w(x[6], x[7], x[8]);
   T f[4], sum_speed = T(0);
@@ -92,11 +101,14 @@ void RotorDynamics(const RotorNominal& n, const T* x, const Eigen::Matrix<T, 3, 
   const T l(n.arm_m);
   const T yaw = u[0] * u[0] - u[1] * u[1] + u[2] * u[2] - u[3] * u[3];
   const T flap = sum_speed * T(kRotorFlapUnit);
+  const T c_r = theta[kThetaRotorInertia] * T(kRotorInertiaUnit);
+  const T spin = u[0] - u[1] + u[2] - u[3], spin_dot = u_dot[0] - u_dot[1] + u_dot[2] - u_dot[3];
   const Vec tau(l * (-f[0] - f[1] + f[2] + f[3]) + theta[kThetaTorqueX] * T(kRotorTorqueUnit) +
-                    flap * theta[kThetaFlapX] * body_v.y(),
+                    flap * theta[kThetaFlapX] * body_v.y() + c_r * spin * w.y(),
                 l * (-f[0] + f[1] + f[2] - f[3]) + theta[kThetaTorqueX + 1] * T(kRotorTorqueUnit) -
-                    flap * theta[kThetaFlapX + 1] * body_v.x(),
-                T(n.moment_coefficient) * theta[kThetaMoment] * yaw + theta[kThetaTorqueX + 2] * T(kRotorTorqueUnit));
+                    flap * theta[kThetaFlapX + 1] * body_v.x() - c_r * spin * w.x(),
+                T(n.moment_coefficient) * theta[kThetaMoment] * yaw + theta[kThetaTorqueX + 2] * T(kRotorTorqueUnit) +
+                    c_r * spin_dot);
   const Vec J(T(n.inertia_kgm2.x()) * theta[kThetaInertiaX], T(n.inertia_kgm2.y()) * theta[kThetaInertiaX + 1],
               T(n.inertia_kgm2.z()) * theta[kThetaInertiaX + 2]);
   const Vec w_dot = (tau - w.cross(J.cwiseProduct(w))).cwiseQuotient(J);
@@ -108,7 +120,9 @@ void RotorDynamics(const RotorNominal& n, const T* x, const Eigen::Matrix<T, 3, 
 }
 
 /// The model with θ known, for PseudoSpectralProblem (models.h): vector state p, v, ω (blocks of 3),
-/// rotation R_world_body, control the four rotor speeds m1..m4 (rad/s).
+/// rotation R_world_body, control the four rotor speeds m1..m4 (rad/s). Its Dynamics has no rotor
+/// accelerations: it serves the kinematic parts (p' = v, R' = R[ω]×) only; v' and ω' are
+/// ParametricCollocationCost's, which differentiates the rotor polynomials.
 struct RotorModel {
   static constexpr int kVectorDim = 9;
   static constexpr int kBlockSize = 3;
@@ -120,7 +134,8 @@ struct RotorModel {
 
   template <typename T>
   void Dynamics(const T* x, const Eigen::Matrix<T, 3, 3>& R, const T* u, T* x_dot, T* omega) const {
-    RotorDynamics(nominal, x, R, u, theta.data(), x_dot);
+    const T no_rates[4] = {T(0), T(0), T(0), T(0)};
+    RotorDynamics(nominal, x, R, u, no_rates, theta.data(), x_dot);
     for (int i = 0; i < 3; ++i) omega[i] = x[6 + i];
   }
 };

@@ -1,15 +1,19 @@
 #pragma once
 /// \file
 /// ParametricCollocationCost: the collocation defect of one vector block of the rotor model
-/// (rotor_model.h) at one node, with the model's parameters θ as a parameter block of their own — the
-/// residual that lets `identify rotors` estimate θ jointly with the trajectory.
+/// (rotor_model.h) at one node, with the rotor accelerations the angular dynamics need and, when
+/// identifying, the model's parameters θ as a parameter block of their own — the residual that lets
+/// `identify rotors` estimate θ jointly with the trajectory and `estimate rotors` use it.
 ///
 /// Contract. For node j of a segment (point order, segment.h) and vector block b (1: v, 2: ω):
-///   ((D X_b)_j − f_b(X_j, R_j, U_j; θ)) / σ_b,
-/// exactly CollocationCost's vector-block residual (collocation_cost.h) with f = RotorDynamics.
-/// Parameter blocks: block b at the N + 1 nodes (point order), node j's other two vector blocks, its
-/// quaternion (x, y, z, w), its control, then θ (kRotorThetaSize). Jacobians analytic through D; f by
-/// ceres::Jet in (x_j, δ_j, u_j, θ), the rotation's lifted to the quaternion (LiftRotationJacobian).
+///   ((D X_b)_j − f_b(X_j, R_j, U_j, (D U)_j; θ)) / σ_b,
+/// CollocationCost's vector-block residual (collocation_cost.h) with f = RotorDynamics and the
+/// rotor accelerations U' = D U of the control polynomial (used by ω' only: the rotors' reaction
+/// torque). Parameter blocks: block b at the N + 1 nodes (point order), node j's other two vector
+/// blocks, its quaternion (x, y, z, w), the control — at the N + 1 nodes for b = 2, at node j for
+/// b = 1 — then θ (kRotorThetaSize) when `kIdentify`; otherwise θ is the constant given. Jacobians
+/// analytic through D; f by ceres::Jet in (x_j, δ_j, u_j, u'_j[, θ]), the rotation's lifted to the
+/// quaternion (LiftRotationJacobian).
 
 #include <ceres/jet.h>
 #include <Eigen/Core>
@@ -22,29 +26,40 @@
 
 namespace cheval::estim::internal {
 
+template <bool kIdentify>
 class ParametricCollocationCost : public BlockCost {
-  static constexpr int kJet = 9 + 3 + 4 + kRotorThetaSize;
+  static constexpr int kTheta = kIdentify ? kRotorThetaSize : 0;
+  static constexpr int kJet = 9 + 3 + 4 + 4 + kTheta;  // x, δ, u, u', θ
 
  public:
-  /// `D`: the segment's differentiation matrix on the unit interval; `part` 1 or 2; `sigma` > 0.
+  /// `D`: the segment's differentiation matrix on the unit interval; `part` 1 or 2; `sigma` > 0;
+  /// `theta`: a parameter block of the problem when kIdentify, else values read now.
   ParametricCollocationCost(const RotorNominal& nominal, const Segment& segment, const Eigen::MatrixXd& D, int j,
                             int part, double sigma, double* theta)
       : nominal_(nominal), degree_(segment.degree()), scale_(segment.derivative_scale), d_(D.row(j)), j_(j),
-        part_(part), inv_sigma_(1.0 / sigma) {
+        part_(part), inv_sigma_(1.0 / sigma), all_controls_(part == 2) {
     for (int k = 0; k <= degree_; ++k) AddBlock(segment.vector[k] + 3 * part, 3);
     for (int b = 0; b < 3; ++b) {
       if (b != part) AddBlock(segment.vector[j] + 3 * b, 3);
     }
     AddBlock(segment.quaternion[j], 4);
-    AddBlock(segment.control[j], 4);
-    AddBlock(theta, kRotorThetaSize);
+    if (all_controls_) {
+      for (int k = 0; k <= degree_; ++k) AddBlock(segment.control[k], 4);
+    } else {
+      AddBlock(segment.control[j], 4);
+    }
+    if constexpr (kIdentify) {
+      AddBlock(theta, kRotorThetaSize);
+    } else {
+      theta_ = Eigen::Map<const RotorThetaVector>(theta);
+    }
     set_num_residuals(3);
   }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const int N = degree_;
     using Jet = ceres::Jet<double, kJet>;
-    Jet x[9], u[4], theta[kRotorThetaSize], x_dot[9];
+    Jet x[9], u[4], u_dot[4], theta[kRotorThetaSize], x_dot[9];
     int next = N + 1;
     for (int i = 0; i < 3; ++i) x[3 * part_ + i] = Jet(parameters[j_][i], 3 * part_ + i);
     for (int b = 0; b < 3; ++b) {
@@ -53,14 +68,25 @@ class ParametricCollocationCost : public BlockCost {
       ++next;
     }
     const double* q = parameters[next++];
-    const double* control = parameters[next++];
-    const double* th = parameters[next];
-    for (int i = 0; i < 4; ++i) u[i] = Jet(control[i], 12 + i);
-    for (int i = 0; i < kRotorThetaSize; ++i) theta[i] = Jet(th[i], 16 + i);
+    const int controls = next;
+    const double* u_j = parameters[controls + (all_controls_ ? j_ : 0)];
+    Eigen::Vector4d rate = Eigen::Vector4d::Zero();
+    if (all_controls_) {
+      for (int k = 0; k <= N; ++k) rate += scale_ * d_[k] * Eigen::Map<const Eigen::Vector4d>(parameters[controls + k]);
+    }
+    next += all_controls_ ? N + 1 : 1;
+    for (int i = 0; i < 4; ++i) {
+      u[i] = Jet(u_j[i], 12 + i);
+      u_dot[i] = Jet(rate[i], 16 + i);
+    }
+    for (int i = 0; i < kRotorThetaSize; ++i) {
+      if constexpr (kIdentify) theta[i] = Jet(parameters[next][i], 20 + i);
+      else theta[i] = Jet(theta_[i]);
+    }
     Eigen::Matrix<Jet, 3, 1> delta;
     for (int i = 0; i < 3; ++i) delta[i] = Jet(0.0, 9 + i);
     const Eigen::Matrix<Jet, 3, 3> R = QuaternionMatrix(q).cast<Jet>() * lie::SO3<Jet>::Exp(delta).Matrix();
-    RotorDynamics(nominal_, x, R, u, theta, x_dot);
+    RotorDynamics(nominal_, x, R, u, u_dot, theta, x_dot);
     Eigen::Vector3d r;
     for (int i = 0; i < 3; ++i) r[i] = -x_dot[3 * part_ + i].a;
     for (int k = 0; k <= N; ++k) r += scale_ * d_[k] * Eigen::Map<const Eigen::Vector3d>(parameters[k]);
@@ -70,30 +96,40 @@ class ParametricCollocationCost : public BlockCost {
     for (int i = 0; i < 3; ++i) df.row(i) = x_dot[3 * part_ + i].v.transpose();
     df *= -inv_sigma_;
     using RowMajor3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+    using RowMajor34 = Eigen::Matrix<double, 3, 4, Eigen::RowMajor>;
     for (int k = 0; k <= N; ++k) {
       if (jacobians[k] == nullptr) continue;
       RowMajor3 J = (inv_sigma_ * scale_ * d_[k]) * RowMajor3::Identity();
-      if (k == j_) J += df.block<3, 3>(0, 3 * part_);
+      if (k == j_) J += df.template block<3, 3>(0, 3 * part_);
       Eigen::Map<RowMajor3>{jacobians[k]} = J;
     }
     next = N + 1;
     for (int b = 0; b < 3; ++b) {
       if (b == part_) continue;
-      if (jacobians[next]) Eigen::Map<RowMajor3>{jacobians[next]} = df.block<3, 3>(0, 3 * b);
+      if (jacobians[next]) Eigen::Map<RowMajor3>{jacobians[next]} = df.template block<3, 3>(0, 3 * b);
       ++next;
     }
     if (jacobians[next]) {
-      const RowMajor3 Jd = df.block<3, 3>(0, 9);
+      const RowMajor3 Jd = df.template block<3, 3>(0, 9);
       LiftRotationJacobian(q, Jd.data(), 3, jacobians[next]);
     }
     ++next;
-    if (jacobians[next]) {
-      Eigen::Map<Eigen::Matrix<double, 3, 4, Eigen::RowMajor>>{jacobians[next]} = df.block<3, 4>(0, 12);
+    if (all_controls_) {  // u_j directly, and u'_j = scale Σ_k d_k u_k
+      for (int k = 0; k <= N; ++k, ++next) {
+        if (jacobians[next] == nullptr) continue;
+        RowMajor34 J = (scale_ * d_[k]) * df.template block<3, 4>(0, 16);
+        if (k == j_) J += df.template block<3, 4>(0, 12);
+        Eigen::Map<RowMajor34>{jacobians[next]} = J;
+      }
+    } else {
+      if (jacobians[next]) Eigen::Map<RowMajor34>{jacobians[next]} = df.template block<3, 4>(0, 12);
+      ++next;
     }
-    ++next;
-    if (jacobians[next]) {
-      Eigen::Map<Eigen::Matrix<double, 3, kRotorThetaSize, Eigen::RowMajor>>{jacobians[next]} =
-          df.block<3, kRotorThetaSize>(0, 16);
+    if constexpr (kIdentify) {
+      if (jacobians[next]) {
+        Eigen::Map<Eigen::Matrix<double, 3, kRotorThetaSize, Eigen::RowMajor>>{jacobians[next]} =
+            df.template block<3, kRotorThetaSize>(0, 20);
+      }
     }
     return true;
   }
@@ -105,6 +141,8 @@ class ParametricCollocationCost : public BlockCost {
   Eigen::RowVectorXd d_;
   int j_, part_;
   double inv_sigma_;
+  bool all_controls_;
+  RotorThetaVector theta_ = RotorThetaVector::Zero();
 };
 
 }  // namespace cheval::estim::internal
