@@ -45,8 +45,9 @@ struct RotorEstimateOptions {
   /// Collocation σ (> 0): p' (m/s), v' (m/s²), ω' (rad/s²), body rate of R (rad/s).
   double sigma_position_rate = 1e-3, sigma_acceleration = 0.3, sigma_angular_acceleration = 3.0,
          sigma_rotation_rate = 1e-3;
-  /// σ of the rotor-speed prior ∫ |Ω'|² dt / σ² (estimation only), rad/s² per s^(1/2) (> 0).
-  double sigma_rotor_rate = 3000.0;
+  /// σ of the rotor-speed prior ∫ |Ω'|² dt / σ² (estimation only), rad/s² per s^(1/2) (> 0). The
+  /// rotor error on each of the three Crazyflie flights is least at 700–1000 (docs/estimator_real_data.md).
+  double sigma_rotor_rate = 1000.0;
   double baseline_window_s = 0.2;  ///< window of the flatness baseline's local fits, s (> 0)
   double score_margin_s = 0.5;     ///< scored samples: flying, this far from a span's ends (>= 0)
   /// Levenberg–Marquardt iterations (>= 1). On the shared flights the rotor speeds after 6 iterations
