@@ -224,6 +224,8 @@ void RotorEstimateOptions::Validate() const {
   check(positive(sigma_rotation_rate), "sigma_rotation_rate", "must be > 0, got {}", sigma_rotation_rate);
   check(positive(sigma_rotor_rate), "sigma_rotor_rate", "must be > 0, got {}", sigma_rotor_rate);
   check(positive(baseline_window_s), "baseline_window_s", "must be > 0, got {}", baseline_window_s);
+  check(positive(identification_piece_s), "identification_piece_s", "must be a positive number of seconds, got {}",
+        identification_piece_s);
   check(score_margin_s >= 0 && std::isfinite(score_margin_s), "score_margin_s", "must be >= 0, got {}", score_margin_s);
   check(positive(function_tolerance), "function_tolerance", "must be > 0, got {}", function_tolerance);
   check(max_iterations >= 1, "max_iterations", "must be >= 1, got {}", max_iterations);
@@ -283,77 +285,148 @@ RotorEstimate EstimateRotors(const RotorFlight& flight, const RotorVehicle& vehi
 
 namespace {
 
-// θ from one flight: the trajectory, its rotor speeds and θ jointly, the rotor speeds measured.
-RotorIdentification IdentifyOne(const RotorFlight& flight, const RotorVehicle& base, const RotorEstimateOptions& o) {
+using ThetaMatrix = Eigen::Matrix<double, kRotorThetaSize, kRotorThetaSize>;
+
+// θ from samples [first, last] of a flight: the trajectory, its rotor speeds and θ jointly, the rotor
+// speeds measured.
+RotorIdentification IdentifyPiece(const RotorFlight& flight, size_t first, size_t last, const RotorVehicle& base,
+                                  const RotorEstimateOptions& o) {
   const auto start = Clock::now();
   const RotorModel model{base.nominal, base.theta};
   const ceres::HuberLoss huber(o.huber);
   RotorThetaVector theta = base.theta;
-  std::vector<std::unique_ptr<Problem>> problems;
-  // One problem per span, all sharing θ: the spans' residuals go into the first problem's Ceres problem
-  // only when there is one span; with several, each is solved in turn with θ carried over.
   RotorIdentification id;
-  double cost = 0;
-  int residuals = 0, parameters = 0;
-  for (const auto& [first, last] : Spans(flight, o.score_margin_s)) {
-    std::unique_ptr<Problem> problem = BuildProblem(flight, first, last, model, o, true, &huber);
-    AddDynamics<true>(*problem, model, o, theta.data());
-    problem->AddPrior(std::make_unique<ThetaPrior>(theta.data(), RotorNominal::PublishedTheta(), PriorSigma()));
-    for (int i = 0; i < 3; ++i) {  // a rigid body's inertia is positive: at least 1 % of the published one
-      problem->ceres_problem().SetParameterLowerBound(theta.data(), kThetaInertiaX + i, 0.01);
-    }
-    for (size_t i = first; i <= last; ++i) {
-      const internal::TimeRow row = problem->RowAt(flight.samples[i].t);
-      problem->AddPrior(std::make_unique<RotorSpeedMeasurement>(problem->SegmentOf(row.segment), row.w,
-                                                                flight.samples[i].rotor, o.rotor_sigma_radps));
-    }
-    const ceres::Solver::Summary summary = problem->Solve(SolverOptions(o));
-    id.converged = summary.termination_type == ceres::CONVERGENCE;
-    cost += summary.final_cost;
-    residuals += summary.num_residuals_reduced;
-    parameters += summary.num_effective_parameters_reduced;
-    problems.push_back(std::move(problem));
+  // J_z is held: every yaw torque (k_M Ω², the rotors' reaction, τ0_z) is seen only through its ratio
+  // to J_z (docs/estimator_real_data.md).
+  ceres::SubsetManifold hold_yaw_inertia(kRotorThetaSize, {kThetaInertiaX + 2});
+  std::unique_ptr<Problem> problem = BuildProblem(flight, first, last, model, o, true, &huber);
+  AddDynamics<true>(*problem, model, o, theta.data());
+  problem->AddPrior(std::make_unique<ThetaPrior>(theta.data(), RotorNominal::PublishedTheta(), PriorSigma()));
+  problem->ceres_problem().SetManifold(theta.data(), &hold_yaw_inertia);
+  for (int i = 0; i < 2; ++i) {  // a rigid body's inertia is positive: at least 1 % of the published one
+    problem->ceres_problem().SetParameterLowerBound(theta.data(), kThetaInertiaX + i, 0.01);
   }
-  // Covariance of θ in the last span's problem (the usual case: one span).
+  for (size_t i = first; i <= last; ++i) {
+    const internal::TimeRow row = problem->RowAt(flight.samples[i].t);
+    problem->AddPrior(std::make_unique<RotorSpeedMeasurement>(problem->SegmentOf(row.segment), row.w,
+                                                              flight.samples[i].rotor, o.rotor_sigma_radps));
+  }
+  const ceres::Solver::Summary summary = problem->Solve(SolverOptions(o));
+  id.converged = summary.termination_type == ceres::CONVERGENCE;
   ceres::Covariance::Options copt;
   copt.num_threads = o.threads;
   ceres::Covariance covariance(copt);
   const std::vector<std::pair<const double*, const double*>> blocks = {{theta.data(), theta.data()}};
-  if (!covariance.Compute(blocks, &problems.back()->ceres_problem())) {
+  if (!covariance.Compute(blocks, &problem->ceres_problem())) {
     throw ComputeError(fmt::format("{}: the covariance of the identified parameters could not be computed (the "
                                    "problem is rank-deficient)",
                                    flight.path));
   }
   covariance.GetCovarianceBlock(theta.data(), theta.data(), id.covariance.data());
-  id.reduced_chi2 = 2.0 * cost / std::max(1, residuals - parameters);
+  id.reduced_chi2 =
+      2.0 * summary.final_cost / std::max(1, summary.num_residuals_reduced - summary.num_effective_parameters_reduced);
   id.covariance *= std::max(1.0, id.reduced_chi2);
   id.theta = theta;
+  id.pieces = 1;
   id.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return id;
 }
 
+// The flying spans cut into pieces of about piece_s (at least one per span), as [first, last].
+std::vector<std::pair<size_t, size_t>> Pieces(const RotorFlight& flight, const RotorEstimateOptions& o) {
+  std::vector<std::pair<size_t, size_t>> out;
+  for (const auto& [first, last] : Spans(flight, o.score_margin_s)) {
+    const double t0 = flight.samples[first].t, length = flight.samples[last].t - t0;
+    const int n = std::max(1, static_cast<int>(std::floor(length / o.identification_piece_s)));
+    size_t begin = first;
+    for (int k = 1; k <= n; ++k) {
+      size_t end = last;
+      if (k < n) {
+        const double cut = t0 + length * k / n;
+        end = begin;
+        while (end + 1 <= last && flight.samples[end + 1].t <= cut) ++end;
+      }
+      out.push_back({begin, end});
+      begin = end + 1;
+    }
+  }
+  return out;
+}
+
 }  // namespace
+
+RotorIdentification CombineIdentifications(const std::vector<RotorIdentification>& pieces) {
+  if (pieces.empty()) throw UsageError("no identification to combine");
+  // The product of the pieces' Gaussians, then each parameter's σ scaled by its Birge ratio
+  // sqrt(Q / (k − 1)), Q = Σ (θ_piece − θ)² / σ²_piece (Cochran's Q): how much farther apart the pieces
+  // are than their own σ says. The correlations are kept.
+  // Entries held in every piece (zero variance) are carried over as they are.
+  std::vector<int> free;
+  for (int i = 0; i < kRotorThetaSize; ++i) {
+    if (pieces.front().covariance(i, i) > 0) free.push_back(i);
+  }
+  const int n = static_cast<int>(free.size());
+  const auto reduce = [&](const ThetaMatrix& m) {
+    Eigen::MatrixXd r(n, n);
+    for (int a = 0; a < n; ++a) {
+      for (int b = 0; b < n; ++b) r(a, b) = m(free[a], free[b]);
+    }
+    return r;
+  };
+  Eigen::MatrixXd information = Eigen::MatrixXd::Zero(n, n);
+  Eigen::VectorXd eta = Eigen::VectorXd::Zero(n);
+  RotorIdentification out;
+  out.theta = pieces.front().theta;
+  for (const RotorIdentification& p : pieces) {
+    const Eigen::MatrixXd lambda = reduce(p.covariance).ldlt().solve(Eigen::MatrixXd::Identity(n, n));
+    Eigen::VectorXd theta(n);
+    for (int a = 0; a < n; ++a) theta[a] = p.theta[free[a]];
+    information += lambda;
+    eta += lambda * theta;
+    out.reduced_chi2 = std::max(out.reduced_chi2, p.reduced_chi2);
+    out.seconds += p.seconds;
+    out.pieces += p.pieces;
+  }
+  const Eigen::MatrixXd covariance = information.ldlt().solve(Eigen::MatrixXd::Identity(n, n));
+  const Eigen::VectorXd theta = covariance * eta;
+  out.covariance.setZero();
+  for (int a = 0; a < n; ++a) {
+    out.theta[free[a]] = theta[a];
+    for (int b = 0; b < n; ++b) out.covariance(free[a], free[b]) = covariance(a, b);
+  }
+  out.dispersion = RotorThetaVector::Ones();
+  if (pieces.size() > 1) {
+    for (int i = 0; i < kRotorThetaSize; ++i) {
+      if (out.covariance(i, i) == 0) continue;
+      double q = 0;
+      for (const RotorIdentification& p : pieces) {
+        q += (p.theta[i] - out.theta[i]) * (p.theta[i] - out.theta[i]) / p.covariance(i, i);
+      }
+      out.dispersion[i] = std::max(1.0, std::sqrt(q / static_cast<double>(pieces.size() - 1)));
+    }
+    out.covariance = out.dispersion.asDiagonal() * out.covariance * out.dispersion.asDiagonal();
+  }
+  out.converged = std::all_of(pieces.begin(), pieces.end(), [](const RotorIdentification& p) { return p.converged; });
+  return out;
+}
 
 RotorVehicle IdentifyRotors(const std::vector<RotorFlight>& flights, const RotorVehicle& base,
                             const RotorEstimateOptions& options, std::vector<RotorIdentification>* per_flight) {
   options.Validate();
   if (flights.empty()) throw UsageError("identification needs at least one flight");
-  using Matrix = Eigen::Matrix<double, kRotorThetaSize, kRotorThetaSize>;
-  Matrix information = Matrix::Zero();
-  RotorThetaVector eta = RotorThetaVector::Zero();
   RotorVehicle out = base;
   out.training.clear();
+  std::vector<RotorIdentification> all;
   for (const RotorFlight& flight : flights) {
-    const RotorIdentification id = IdentifyOne(flight, base, options);
-    const Matrix lambda = id.covariance.ldlt().solve(Matrix::Identity());
-    information += lambda;
-    eta += lambda * id.theta;
+    std::vector<RotorIdentification> pieces;
+    for (const auto& [first, last] : Pieces(flight, options)) pieces.push_back(IdentifyPiece(flight, first, last, base, options));
+    all.insert(all.end(), pieces.begin(), pieces.end());
     out.training.push_back(flight.path);
-    if (per_flight) per_flight->push_back(id);
+    if (per_flight) per_flight->push_back(CombineIdentifications(pieces));
   }
-  const Matrix combined = information.ldlt().solve(Matrix::Identity());
-  out.theta = combined * eta;
-  out.theta_sigma = combined.diagonal().cwiseSqrt();
+  const RotorIdentification combined = CombineIdentifications(all);
+  out.theta = combined.theta;
+  out.theta_sigma = combined.covariance.diagonal().cwiseSqrt();
   return out;
 }
 

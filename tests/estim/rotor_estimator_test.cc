@@ -138,14 +138,15 @@ TEST(RotorEstimator, EstimateReachesSimulatedAccuracy) {
   EXPECT_NEAR(e.duration_s, 8.0, 0.02);
 }
 
-// Identification from a base vehicle with wrong published values recovers the true ones.
+// Identification from a base vehicle with wrong published values recovers the true ones; J_z, which
+// only scales the yaw torques' ratios to it, is held at the base's (here the true) value.
 TEST(RotorIdentification, RecoversPerturbedParameters) {
   const estim::RotorFlight flight = SimulatedFlight(sim::QuadrotorScenario::kLissajous, 10.0);
   estim::RotorVehicle base = SimRotorVehicle();
   const estim::RotorNominal truth = base.nominal;
   base.nominal.thrust_coefficient *= 1.1;
   base.nominal.moment_coefficient *= 0.6;
-  base.nominal.inertia_kgm2 = base.nominal.inertia_kgm2.cwiseProduct(Eigen::Vector3d(0.8, 1.25, 1.5));
+  base.nominal.inertia_kgm2 = base.nominal.inertia_kgm2.cwiseProduct(Eigen::Vector3d(0.8, 1.25, 1.0));
   std::vector<estim::RotorIdentification> per_flight;
   estim::RotorEstimateOptions options;
   options.rotor_sigma_radps = 1.0;  // the simulator's rotor speeds are exact (the default 30 is for ESC telemetry)
@@ -160,8 +161,10 @@ TEST(RotorIdentification, RecoversPerturbedParameters) {
   expected.head<4>().setConstant(truth.thrust_coefficient / base.nominal.thrust_coefficient);
   for (int i = 0; i < 3; ++i) expected[estim::kThetaInertiaX + i] = truth.inertia_kgm2[i] / base.nominal.inertia_kgm2[i];
   expected[estim::kThetaMoment] = truth.moment_coefficient / base.nominal.moment_coefficient;
+  EXPECT_EQ(id.theta[estim::kThetaInertiaX + 2], 1.0);  // held
+  EXPECT_EQ(id.theta_sigma[estim::kThetaInertiaX + 2], 0.0);
   for (int i = 0; i < estim::kRotorThetaSize; ++i) {
-    EXPECT_GT(id.theta_sigma[i], 0) << i;
+    if (i != estim::kThetaInertiaX + 2) EXPECT_GT(id.theta_sigma[i], 0) << i;
     EXPECT_LT(std::abs(id.theta[i] - expected[i]), 3 * id.theta_sigma[i] + 1e-3)
         << i << ": " << id.theta[i] << " +- " << id.theta_sigma[i] << ", truth " << expected[i];
   }
@@ -169,6 +172,31 @@ TEST(RotorIdentification, RecoversPerturbedParameters) {
   for (int i = 0; i < 2; ++i) {
     EXPECT_NEAR(id.theta[estim::kThetaInertiaX + i] / expected[estim::kThetaInertiaX + i], 1.0, 0.1) << i;
   }
+}
+
+// Pieces that agree within their σ combine as the product of their Gaussians; pieces farther apart
+// than their σ say widen σ by the Birge ratio; a held entry (zero variance) stays as it is.
+TEST(RotorIdentification, CombinationWidensSigmaByTheDispersion) {
+  estim::RotorIdentification a, b;
+  a.covariance.setZero();
+  a.covariance.diagonal().setConstant(0.01);  // σ 0.1 each
+  a.covariance(6, 6) = 0;                     // held
+  b.covariance = a.covariance;
+  a.theta = estim::RotorNominal::PublishedTheta();
+  b.theta = a.theta;
+  b.theta[0] += 0.1;   // 1 σ of a difference of two: consistent
+  b.theta[11] += 2.0;  // 20 σ: not
+  a.pieces = b.pieces = 1;
+  const estim::RotorIdentification c = estim::CombineIdentifications({a, b});
+  EXPECT_EQ(c.pieces, 2);
+  EXPECT_NEAR(c.theta[0], a.theta[0] + 0.05, 1e-12);
+  EXPECT_NEAR(std::sqrt(c.covariance(0, 0)), 0.1 / std::sqrt(2.0), 1e-12);  // Q = 0.5 < 1: not widened
+  EXPECT_NEAR(c.theta[11], a.theta[11] + 1.0, 1e-12);
+  // Q = 2 · (1 / 0.1)² = 200, Birge ratio sqrt(200) ≈ 14.1: σ 0.0707 → 1.0, the half-distance.
+  EXPECT_NEAR(std::sqrt(c.covariance(11, 11)), 1.0, 1e-9);
+  EXPECT_EQ(c.covariance(6, 6), 0.0);
+  EXPECT_EQ(c.theta[6], a.theta[6]);
+  EXPECT_THROW(estim::CombineIdentifications({}), UsageError);
 }
 
 TEST(RotorVehicleFile, RoundTripAndErrors) {

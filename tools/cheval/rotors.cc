@@ -117,8 +117,9 @@ void RegisterIdentifyRotors(CLI::App& app, Action* action) {
       std::vector<estim::RotorIdentification> per_flight;
       const estim::RotorVehicle out = estim::IdentifyRotors(flights, base, flags->options, &per_flight);
       for (size_t f = 0; f < flights.size(); ++f) {
-        fmt::print("{}: {:.2f} s, reduced chi2 {:.3g}{}\n", flights[f].path, per_flight[f].seconds,
-                   per_flight[f].reduced_chi2, per_flight[f].converged ? "" : "  (did not converge)");
+        fmt::print("{}: {} piece(s), {:.2f} s, reduced chi2 <= {:.3g}{}\n", flights[f].path, per_flight[f].pieces,
+                   per_flight[f].seconds, per_flight[f].reduced_chi2,
+                   per_flight[f].converged ? "" : "  (a piece did not converge)");
       }
       const char* names[] = {"k_m1/k_F", "k_m2/k_F", "k_m3/k_F", "k_m4/k_F", "Jx/Jx_pub", "Jy/Jy_pub",
                              "Jz/Jz_pub", "k_M/Kc", "tau0_x [1e-5 N m]", "tau0_y [1e-5 N m]",

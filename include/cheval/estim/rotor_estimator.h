@@ -49,6 +49,9 @@ struct RotorEstimateOptions {
   /// rotor error on each of the three Crazyflie flights is least at 700–1000 (docs/estimator_real_data.md).
   double sigma_rotor_rate = 1000.0;
   double baseline_window_s = 0.2;  ///< window of the flatness baseline's local fits, s (> 0)
+  /// Identification: each flying span is cut into pieces of about this length (s, > 0; a shorter
+  /// span is one piece), identified one by one; their spread enters θ's σ (IdentifyRotors).
+  double identification_piece_s = 8.0;
   double score_margin_s = 0.5;     ///< scored samples: flying, this far from a span's ends (>= 0)
   /// Levenberg–Marquardt iterations (>= 1). On the shared flights the rotor speeds after 6 iterations
   /// differ from those after 30 by < 0.1 % of the speed (docs/estimator_real_data.md).
@@ -107,20 +110,34 @@ RotorError ScoreRotors(const RotorFlight& flight, const std::vector<Eigen::Vecto
 /// bad options, ComputeError when no flying span is longer than 2 · score_margin_s + 0.1 s.
 RotorEstimate EstimateRotors(const RotorFlight& flight, const RotorVehicle& vehicle, const RotorEstimateOptions& options);
 
-/// θ identified from one flight, with its covariance.
+/// θ identified from a piece of flight, or combined from several.
 struct RotorIdentification {
   RotorThetaVector theta = RotorThetaVector::Zero();
-  Eigen::Matrix<double, kRotorThetaSize, kRotorThetaSize> covariance;  ///< scaled by the reduced χ²
-  double reduced_chi2 = 0;
+  /// Scaled by the reduced χ² (each piece's); combined: by the dispersion too.
+  Eigen::Matrix<double, kRotorThetaSize, kRotorThetaSize> covariance;
+  /// Combined: each parameter's Birge ratio (>= 1), by which its σ was scaled.
+  RotorThetaVector dispersion = RotorThetaVector::Ones();
+  double reduced_chi2 = 0;  ///< combined: the largest of the pieces'
   double seconds = 0;
+  int pieces = 0;
   bool converged = false;
 };
 
-/// Identifies θ on each flight jointly with its trajectory and rotor speeds (the measured rotor speeds
-/// as measurements with σ rotor_sigma_radps; a weak prior keeps θ within reach of the published vehicle: σ 1 on the relative entries,
-/// 100 units on τ0 and drag), then combines the flights by their information (the product of the
-/// Gaussian marginals of θ). Returns the vehicle with the combined θ and σ, and `per_flight` each
-/// flight's own. ComputeError when a covariance cannot be computed.
+/// Combines identifications by their information (the product of their Gaussians), then scales each
+/// parameter's σ by its Birge ratio sqrt(Q / (k − 1)) when above 1, Q = Cochran's Σ (θ_piece − θ)² /
+/// σ²_piece: the σ then covers how far apart the pieces are, not only how well each determines θ
+/// (Birge 1932; the pieces' residuals are correlated in time, which each piece's covariance ignores).
+/// One piece: returned as it is. UsageError when empty.
+RotorIdentification CombineIdentifications(const std::vector<RotorIdentification>& pieces);
+
+/// Identifies θ jointly with the trajectory and rotor speeds (the measured rotor speeds as
+/// measurements with σ rotor_sigma_radps; a weak prior keeps θ within reach of the published
+/// vehicle: σ 1 on the relative entries, 100 units on the others) on each piece of about
+/// identification_piece_s of every flying span, and combines the pieces by CombineIdentifications:
+/// θ's σ then holds how much θ changes from one stretch of flight to another, which the solver's
+/// covariance alone (residuals taken as independent) does not. Returns the vehicle with the combined
+/// θ and σ, and `per_flight` each flight's own combination. ComputeError when a covariance cannot be
+/// computed.
 RotorVehicle IdentifyRotors(const std::vector<RotorFlight>& flights, const RotorVehicle& base,
                             const RotorEstimateOptions& options, std::vector<RotorIdentification>* per_flight);
 
