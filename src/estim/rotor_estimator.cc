@@ -25,35 +25,30 @@ namespace {
 using Problem = PseudoSpectralProblem<RotorModel>;
 using Clock = std::chrono::steady_clock;
 
-// A motion-capture position, whitened.
-struct PositionMeasurement {
-  Eigen::Vector3d p;
+// The measurements of a sample, whitened, each its own residual block with its own robust loss and
+// only the blocks it depends on: the onboard attitude (the rotation error vee(skew(R_measᵀ R)), =
+// Log(R_measᵀ R) to second order), the body rate and, when fresh, the motion-capture position.
+struct AttitudeMeasurement {
+  Eigen::Matrix3d measured_transpose;
   double inv_sigma;
   template <typename T>
-  bool operator()(const T* x, const Eigen::Matrix<T, 3, 3>& /*R*/, T* r) const {
-    for (int i = 0; i < 3; ++i) r[i] = (x[i] - T(p[i])) * T(inv_sigma);
+  bool operator()(const T* /*x*/, const Eigen::Matrix<T, 3, 3>& R, T* r) const {
+    const Eigen::Matrix<T, 3, 3> M = measured_transpose.cast<T>() * R;
+    r[0] = T(0.5 * inv_sigma) * (M(2, 1) - M(1, 2));
+    r[1] = T(0.5 * inv_sigma) * (M(0, 2) - M(2, 0));
+    r[2] = T(0.5 * inv_sigma) * (M(1, 0) - M(0, 1));
     return true;
   }
 };
 
-// The onboard attitude (rows 0–2: the rotation error vee(skew(R_measᵀ R)), = Log(R_measᵀ R) to second
-// order), body rate (rows 3–5) and, when the sample has a fresh one, the motion-capture position (rows
-// 6–8; else 0), whitened: one residual block per sample.
-struct SampleMeasurement {
-  Eigen::Matrix3d measured_transpose;
-  Eigen::Vector3d w;
-  double inv_attitude, inv_rate;
-  bool has_position;
-  PositionMeasurement position;
+// x's entries [offset, offset + 3) against a measured vector (offset 0: position, 6: body rate).
+struct VectorMeasurement {
+  Eigen::Vector3d measured;
+  int offset;
+  double inv_sigma;
   template <typename T>
-  bool operator()(const T* x, const Eigen::Matrix<T, 3, 3>& R, T* r) const {
-    const Eigen::Matrix<T, 3, 3> M = measured_transpose.cast<T>() * R;
-    r[0] = T(0.5 * inv_attitude) * (M(2, 1) - M(1, 2));
-    r[1] = T(0.5 * inv_attitude) * (M(0, 2) - M(2, 0));
-    r[2] = T(0.5 * inv_attitude) * (M(1, 0) - M(0, 1));
-    for (int i = 0; i < 3; ++i) r[3 + i] = (x[6 + i] - T(w[i])) * T(inv_rate);
-    if (has_position) return position(x, R, r + 6);
-    for (int i = 6; i < 9; ++i) r[i] = T(0);
+  bool operator()(const T* x, const Eigen::Matrix<T, 3, 3>& /*R*/, T* r) const {
+    for (int i = 0; i < 3; ++i) r[i] = (x[offset + i] - T(measured[i])) * T(inv_sigma);
     return true;
   }
 };
@@ -159,11 +154,12 @@ std::unique_ptr<Problem> BuildProblem(const RotorFlight& flight, size_t first, s
   }
   problem->SetChartReferences();
   for (size_t i = first; i <= last; ++i) {
-    problem->AddMeasurement(s[i].t,
-                            SampleMeasurement{s[i].q.toRotationMatrix().transpose(), s[i].w, 1.0 / o.attitude_sigma_rad,
-                                              1.0 / o.rate_sigma_radps, s[i].fresh_position,
-                                              PositionMeasurement{s[i].p, 1.0 / o.position_sigma_m}},
-                            9, 3, {0, 2}, loss);
+    problem->AddMeasurement(s[i].t, AttitudeMeasurement{s[i].q.toRotationMatrix().transpose(), 1.0 / o.attitude_sigma_rad},
+                            3, 3, {}, loss);
+    problem->AddMeasurement(s[i].t, VectorMeasurement{s[i].w, 6, 1.0 / o.rate_sigma_radps}, 3, 3, {2}, loss, false);
+    if (s[i].fresh_position) {
+      problem->AddMeasurement(s[i].t, VectorMeasurement{s[i].p, 0, 1.0 / o.position_sigma_m}, 3, 3, {0}, loss, false);
+    }
   }
   return problem;
 }

@@ -286,6 +286,42 @@ TEST(PseudoSpectralProblem, CompressedMeasurementKeepsCostGradientAndNormalMatri
   }
 }
 
+// A vector measurement declared not to use the rotation has no quaternion among its blocks and the
+// same cost, gradient and Gauss–Newton matrix as the same measurement with the rotation among them
+// (its functor ignores R: the rotation's columns are zero).
+struct VectorObservation {
+  template <typename T>
+  bool operator()(const T* x, const Eigen::Matrix<T, 3, 3>& /*R*/, T* r) const {
+    for (int e = 0; e < 3; ++e) r[e] = x[e] * x[e] - T(0.2 * e);
+    return true;
+  }
+};
+TEST(PseudoSpectralProblem, MeasurementWithoutRotationKeepsNormalEquations) {
+  auto without = AttitudeProblem(6, false);
+  auto with = AttitudeProblem(6, false);
+  ceres::HuberLoss loss(0.3);
+  for (double t : {0.37, 1.61}) {
+    without.AddMeasurement(t, VectorObservation{}, 3, 3, {0}, &loss, false);
+    with.AddMeasurement(t, VectorObservation{}, 3, 3, {0}, &loss, true);
+  }
+  std::vector<ceres::ResidualBlockId> ids;
+  without.ceres_problem().GetResidualBlocks(&ids);
+  int vector_only = 0;  // residual blocks on the 7 nodes' vector blocks and nothing else: the measurements
+  for (ceres::ResidualBlockId id : ids) {
+    std::vector<double*> blocks;
+    without.ceres_problem().GetParameterBlocksForResidualBlock(id, &blocks);
+    vector_only += blocks.size() == 7 && std::all_of(blocks.begin(), blocks.end(), [&](double* b) {
+                     return without.ceres_problem().ParameterBlockSize(b) == 3;
+                   });
+  }
+  EXPECT_EQ(vector_only, 2);
+  const Normal a = NormalEquations(without), b = NormalEquations(with);
+  EXPECT_NEAR(a.cost, b.cost, 1e-12 * b.cost);
+  EXPECT_LT((a.gradient - b.gradient).cwiseAbs().maxCoeff(), 1e-12 * b.gradient.cwiseAbs().maxCoeff());
+  EXPECT_LT((a.JtJ - b.JtJ).cwiseAbs().maxCoeff(), 1e-12 * b.JtJ.cwiseAbs().maxCoeff());
+  ExpectGradientMatchesDifferences(without);
+}
+
 TEST(PseudoSpectralProblem, OutsideIntervalIsAnError) {
   auto problem = AttitudeProblem(6, false);
   PointObservation obs{{{1, 2, 3}}};

@@ -229,18 +229,21 @@ class PseudoSpectralProblem {
   /// returning `rows` residuals (already whitened), in groups of `group_rows` rows sharing one robust
   /// `loss` (may be null; the problem does not own it). `used_blocks` lists the vector blocks h
   /// depends on (the rotation is always included when the model has one). Throws ComputeError when t
-  /// is outside the interval.
+  /// is outside the interval. `uses_rotation` false: h does not depend on the rotation (it gets the
+  /// identity), which then is none of the measurement's blocks.
   template <class F>
   void AddMeasurement(double t, F functor, int rows, int group_rows, const std::vector<int>& used_blocks,
-                      const ceres::LossFunction* loss = nullptr) {
+                      const ceres::LossFunction* loss = nullptr, bool uses_rotation = true) {
     internal::TimeRow row = RowAt(t);
     const int s = row.segment;
     auto cost = std::make_unique<internal::MeasurementCost<Model, F>>(SegmentOf(s), std::move(row), std::move(functor),
-                                                                      rows, group_rows, used_blocks, loss);
+                                                                      rows, group_rows, used_blocks, loss, uses_rotation);
     ceres::LossFunction* ceres_loss = cost->ceres_loss();
     Add(std::move(cost), ceres_loss);
     if constexpr (kRotation) {
-      for (int k = 0; k <= degree_; ++k) UseManifold(NodeOf(s, k));
+      if (uses_rotation) {
+        for (int k = 0; k <= degree_; ++k) UseManifold(NodeOf(s, k));
+      }
     }
   }
 

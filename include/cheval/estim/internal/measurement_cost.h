@@ -13,7 +13,8 @@
 /// Gauss–Newton matrix as the original rows, with the loss applied inside (ceres_loss() is then
 /// null). Evaluated without Jacobians, a compressed cost returns (sqrt(Σρ), 0, …, 0): only its
 /// squared norm is meaningful. Parameter blocks: per node of the segment (point order), the used
-/// vector blocks, then the quaternion (models with a rotation). h is differentiated by ceres::Jet in
+/// vector blocks, then the quaternion (models with a rotation, unless the measurement is declared
+/// not to use it: then h's R is the identity, and the node's rotation is none of its blocks). h is differentiated by ceres::Jet in
 /// the local tangent at t and carried to the nodes through the row (rotation: J_r(φ(t)) J_r⁻¹(φ_k)).
 
 #include <algorithm>
@@ -42,24 +43,26 @@ class MeasurementCost : public BlockCost {
 
  public:
   /// `used`: the vector blocks h depends on (the others are read from the segment's storage and
-  /// held). `loss` may be null; it is not owned. Throws UsageError for rows that are not a positive
-  /// multiple of group_rows or a block that does not exist.
+  /// held); `uses_rotation`: whether h depends on R (models with a rotation). `loss` may be null; it
+  /// is not owned. Throws UsageError for rows that are not a positive multiple of group_rows or a
+  /// block that does not exist.
   MeasurementCost(const Segment& segment, TimeRow row, F functor, int rows, int group_rows, std::vector<int> used,
-                  const ceres::LossFunction* loss)
+                  const ceres::LossFunction* loss, bool uses_rotation = true)
       : storage_(segment.vector), reference_(segment.reference), row_(std::move(row)), f_(std::move(functor)),
-        rows_(rows), group_rows_(group_rows), used_(std::move(used)), loss_(loss) {
+        rows_(rows), group_rows_(group_rows), used_(std::move(used)), loss_(loss),
+        rotation_(kRotation && uses_rotation) {
     if (rows_ < 1 || group_rows_ < 1 || rows_ % group_rows_ != 0) {
       throw UsageError("measurement rows must be a positive multiple of the group size");
     }
     for (int b : used_) {
       if (b < 0 || b >= kBlocks) throw UsageError("measurement uses a vector block that does not exist");
     }
-    used_dim_ = static_cast<int>(used_.size()) * kBlock + (kRotation ? 3 : 0);
+    used_dim_ = static_cast<int>(used_.size()) * kBlock + (rotation_ ? 3 : 0);
     compress_ = rows_ > used_dim_ + 1;
     set_num_residuals(compress_ ? used_dim_ + 1 : rows_);
     for (int k = 0; k <= segment.degree(); ++k) {
       for (int b : used_) AddBlock(segment.vector[k] + b * kBlock, kBlock);
-      if (kRotation) AddBlock(segment.quaternion[k], 4);
+      if (rotation_) AddBlock(segment.quaternion[k], 4);
     }
   }
   int segment() const { return row_.segment; }
@@ -68,13 +71,13 @@ class MeasurementCost : public BlockCost {
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const int N = static_cast<int>(storage_.size()) - 1;
-    const int per_node = static_cast<int>(used_.size()) + (kRotation ? 1 : 0);
+    const int per_node = static_cast<int>(used_.size()) + (rotation_ ? 1 : 0);
     // Interpolated state: used blocks from the parameters, the others from the problem's storage.
     Eigen::Matrix<double, kVector, 1> x = Eigen::Matrix<double, kVector, 1>::Zero();
     Eigen::Vector3d phi = Eigen::Vector3d::Zero();
     std::vector<Eigen::Vector3d> phis;
     std::vector<Eigen::Matrix3d> jr_inv;
-    if constexpr (kRotation) {
+    if (rotation_) {
       phis.resize(N + 1);
       jr_inv.resize(N + 1);
     }
@@ -85,7 +88,7 @@ class MeasurementCost : public BlockCost {
                                               : parameters[k * per_node + static_cast<int>(it - used_.begin())];
         x.segment(b * kBlock, kBlock) += row_.w[k] * Eigen::Map<const Eigen::Matrix<double, kBlock, 1>>(src);
       }
-      if constexpr (kRotation) {
+      if (rotation_) {
         phis[k] = ChartVector(reference_, parameters[k * per_node + per_node - 1]);
         jr_inv[k] = lie::SO3d::InverseRightJacobian(phis[k]);
         phi += row_.w[k] * phis[k];
@@ -95,7 +98,7 @@ class MeasurementCost : public BlockCost {
       // Residual only (Ceres then needs only the cost): h in doubles, and a residual vector with
       // the same squared norm, (sqrt(Σ ρ), 0, ..., 0).
       Eigen::Matrix3d R_t = Eigen::Matrix3d::Identity();
-      if constexpr (kRotation) R_t = reference_ * lie::SO3d::Exp(phi).Matrix();
+      if (rotation_) R_t = reference_ * lie::SO3d::Exp(phi).Matrix();
       std::vector<double> h(rows_);
       if (!f_(x.data(), R_t, h.data())) return false;
       double cost = 0.0;
@@ -116,7 +119,7 @@ class MeasurementCost : public BlockCost {
     for (int i = 0; i < kVector; ++i) xj[i] = Jet(x[i], i);
     Eigen::Matrix<Jet, 3, 3> R = Eigen::Matrix<Jet, 3, 3>::Identity();
     Eigen::Matrix3d jr_t = Eigen::Matrix3d::Identity();
-    if constexpr (kRotation) {
+    if (rotation_) {
       Eigen::Matrix<Jet, 3, 1> delta;
       for (int i = 0; i < 3; ++i) delta[i] = Jet(0.0, kVector + i);
       const Eigen::Matrix3d R_t = reference_ * lie::SO3d::Exp(phi).Matrix();
@@ -134,7 +137,7 @@ class MeasurementCost : public BlockCost {
       for (int b : used_) {
         for (int e = 0; e < kBlock; ++e) J(i, c++) = h[i].v[b * kBlock + e];
       }
-      if (kRotation) {
+      if (rotation_) {
         for (int e = 0; e < 3; ++e) J(i, c++) = h[i].v[kVector + e];
       }
     }
@@ -179,7 +182,7 @@ class MeasurementCost : public BlockCost {
         Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, kBlock, Eigen::RowMajor>>(jac, m, kBlock) =
             row_.w[k] * out_J.middleCols(c, kBlock);
       }
-      if constexpr (kRotation) {
+      if (rotation_) {
         double* jac = jacobians[k * per_node + per_node - 1];
         if (jac == nullptr) continue;
         const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> Jd =
@@ -198,6 +201,7 @@ class MeasurementCost : public BlockCost {
   int rows_, group_rows_;
   std::vector<int> used_;
   const ceres::LossFunction* loss_;
+  bool rotation_;
   int used_dim_ = 0;
   bool compress_ = false;
 };
