@@ -169,7 +169,11 @@ TEST(RotorPageTest, SelfContainedPageWithoutFolders) {
   EXPECT_NE(page.find("'rotor-' + motor.name"), std::string::npos) << "the rotor page's script";
   EXPECT_EQ(page.find("{{"), std::string::npos) << "every marker replaced";
   EXPECT_EQ(page.find("/secret/folder"), std::string::npos);
-  EXPECT_EQ(page.find("<script src"), std::string::npos) << "nothing loaded from elsewhere";
+  EXPECT_EQ(page.find(" src="), std::string::npos) << "nothing loaded from elsewhere";
+  EXPECT_EQ(page.find("<link"), std::string::npos);
+  size_t scripts = 0;
+  for (size_t at = page.find("<script"); at != std::string::npos; at = page.find("<script", at + 1)) ++scripts;
+  EXPECT_EQ(scripts, 3u) << "data, chart library, page script";
 }
 
 }  // namespace
