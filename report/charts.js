@@ -202,7 +202,8 @@ const ChevalCharts = (function () {
   const legendMarkers = (colors) => ({ markers: { width: 3, fill: (u, i) => colors[i], stroke: (u, i) => colors[i] } });
 
   // Lines over a sorted x: spec {xLabel, yLabel, lines: [{label, color, x, y, dash, width, points,
-  // stepped, show}], log, height, range: [lo, hi] of y (else automatic)}.
+  // stepped, show}], log, height, range: [lo, hi] of y (else automatic), shade: [[x0, x1], ...] spans
+  // drawn grey behind the lines}.
   function lineChart(entry, spec) {
     entry.redraw = () => lineChart(entry, spec);
     const lines = spec.lines;
@@ -232,6 +233,7 @@ const ChevalCharts = (function () {
       axes: [{ label: spec.xLabel }, { label: spec.yLabel, size: 64, values: spec.log ? (u, s) => s.map((v) => (v === null ? '' : v.toExponential(0))) : undefined }],
       series, legend: legendMarkers([null, ...lines.map((l) => l.color)]),
       cursor: { drag: { x: true, y: false } },
+      hooks: spec.shade ? { drawClear: [(u) => shadeSpans(u, spec.shade)] } : {},
     }, joined, target);
     setPlot(entry, chart, countPoints(lines.map((l) => l.y)));
     target.append(chart.root);
@@ -239,11 +241,26 @@ const ChevalCharts = (function () {
       title: entry.title, width: chart.width, height: chart.height + 40,
       x: { label: spec.xLabel, min: chart.scales.x.min, max: chart.scales.x.max },
       y: { label: spec.yLabel, min: chart.scales.y.min, max: chart.scales.y.max, log: !!spec.log },
-      items: lines.filter((l, i) => chart.series[i + 1].show).map((l) => ({ type: 'line', x: l.x, y: l.y, color: l.color, dash: l.dash, width: l.width })),
+      items: (spec.shade || []).map(([x0, x1]) => ({ type: 'rect', x0, x1, y0: chart.scales.y.min, y1: chart.scales.y.max, fill: shade, opacity: 0.15 }))
+        .concat(lines.filter((l, i) => chart.series[i + 1].show).map((l) => ({ type: 'line', x: l.x, y: l.y, color: l.color, dash: l.dash, width: l.width }))),
       legend: lines.filter((l, i) => chart.series[i + 1].show).map((l) => ({ label: l.label, color: l.color, dash: l.dash })),
     });
     entry.csv = () => csvOf([spec.xLabel, ...lines.map((l) => l.label)], joined[0].map((x, r) => [x, ...joined.slice(1).map((c) => c[r])]));
     return chart;
+  }
+
+  // Spans [x0, x1] of the x axis shaded over the plot's height (behind the series).
+  const shade = '#8c959f';
+  function shadeSpans(u, spans) {
+    const ctx = u.ctx;
+    ctx.save();
+    ctx.fillStyle = shade + '26';
+    for (const [x0, x1] of spans) {
+      const a = u.valToPos(x0, 'x', true), b = u.valToPos(x1, 'x', true);
+      const left = Math.max(u.bbox.left, Math.min(a, b)), right = Math.min(u.bbox.left + u.bbox.width, Math.max(a, b));
+      if (right > left) ctx.fillRect(left, u.bbox.top, right - left, u.bbox.height);
+    }
+    ctx.restore();
   }
 
   // A path in the plane joined in file order (uPlot's own line builder assumes increasing x).
@@ -378,5 +395,21 @@ const ChevalCharts = (function () {
     }
   }
 
-  return { relayout, charts, palette, el, finite, extent, colormap, svgDocument, pngOf, csvOf, chartBox, lineChart, pathChart, svgChart };
+  // Draws a page: window.chevalReport lists the charts and the data; `draw` makes the charts, which
+  // are then fitted to their boxes (and again on a resize); the body gets data-ready (the number of
+  // charts) or, if anything failed, data-error.
+  function drawPage(data, draw) {
+    window.chevalReport = { charts, data };
+    try {
+      draw();
+      relayout();
+      window.addEventListener('resize', relayout);
+      document.body.dataset.ready = String(charts.length);
+    } catch (error) {
+      document.body.dataset.error = String(error && error.stack ? error.stack : error);
+      throw error;
+    }
+  }
+
+  return { drawPage, relayout, charts, palette, el, finite, extent, colormap, svgDocument, pngOf, csvOf, chartBox, lineChart, pathChart, svgChart };
 })();

@@ -1,7 +1,8 @@
 # Writes the C++ source that embeds the report page's files into the library (cmake -P; run by the
 # build, see report/report.cmake): cheval::report::detail::EmbeddedPageAssets() returns their bytes.
-# Inputs (-D): OUTPUT, ASSETS_HEADER, PAGE_TEMPLATE, PAGE_SCRIPT, PAGE_STYLE, CHART_SCRIPT,
-# CHART_STYLE, CHART_PACKAGE (the chart library's package.json, for its name and version).
+# Inputs (-D): OUTPUT, ASSETS_HEADER, FRAME (the pages' common HTML), PAGE_TEMPLATE, PAGE_SCRIPT, PAGE_STYLE, CHART_SCRIPT,
+# CHART_STYLE, CHART_PACKAGE (the chart library's package.json, for its name and version),
+# ROTOR_TEMPLATE and ROTOR_SCRIPT (the rotor-speed page of `cheval estimate rotors --report`).
 cmake_minimum_required(VERSION 3.22)
 
 # `var` gets "{0x3c,0x21,...,0x00}": the bytes of `file` and a terminating zero. Scripts and styles
@@ -23,18 +24,25 @@ function(cheval_bytes var file end_tag)
   set(${var} "{${bytes}0x00}" PARENT_SCOPE)
 endfunction()
 
+cheval_bytes(frame "${FRAME}" "")
 cheval_bytes(page_template "${PAGE_TEMPLATE}" "")
-# PAGE_SCRIPT: the page's scripts separated by '|', embedded one after the other as one script.
-string(REPLACE "|" ";" page_scripts "${PAGE_SCRIPT}")
-set(page_script "{")
-foreach(script IN LISTS page_scripts)
-  cheval_bytes(bytes "${script}" "</script")
-  string(LENGTH "${bytes}" length)
-  math(EXPR length "${length} - 6")  # without "{" and "0x00}"
-  string(SUBSTRING "${bytes}" 1 ${length} bytes)
-  string(APPEND page_script "${bytes}0x0a,\n")
-endforeach()
-string(APPEND page_script "0x00}")
+cheval_bytes(rotor_template "${ROTOR_TEMPLATE}" "")
+# A page's scripts separated by '|', embedded one after the other as one script.
+function(cheval_scripts var scripts_text)
+  string(REPLACE "|" ";" scripts "${scripts_text}")
+  set(joined "{")
+  foreach(script IN LISTS scripts)
+    cheval_bytes(bytes "${script}" "</script")
+    string(LENGTH "${bytes}" length)
+    math(EXPR length "${length} - 6")  # without "{" and "0x00}"
+    string(SUBSTRING "${bytes}" 1 ${length} bytes)
+    string(APPEND joined "${bytes}0x0a,\n")
+  endforeach()
+  string(APPEND joined "0x00}")
+  set(${var} "${joined}" PARENT_SCOPE)
+endfunction()
+cheval_scripts(page_script "${PAGE_SCRIPT}")
+cheval_scripts(rotor_script "${ROTOR_SCRIPT}")
 cheval_bytes(page_style "${PAGE_STYLE}" "</style")
 cheval_bytes(chart_script "${CHART_SCRIPT}" "</script")
 cheval_bytes(chart_style "${CHART_STYLE}" "</style")
@@ -53,6 +61,9 @@ const unsigned char kPageScript[] = ${page_script};
 const unsigned char kPageStyle[] = ${page_style};
 const unsigned char kChartScript[] = ${chart_script};
 const unsigned char kChartStyle[] = ${chart_style};
+const unsigned char kFrame[] = ${frame};
+const unsigned char kRotorTemplate[] = ${rotor_template};
+const unsigned char kRotorScript[] = ${rotor_script};
 
 template <size_t N>
 std::string_view Text(const unsigned char (&bytes)[N]) {
@@ -63,7 +74,7 @@ std::string_view Text(const unsigned char (&bytes)[N]) {
 
 std::optional<PageAssets> EmbeddedPageAssets() {
   return PageAssets{Text(kPageTemplate), Text(kPageScript), Text(kPageStyle), Text(kChartScript), Text(kChartStyle),
-                    \"${chart_name} ${chart_version}\"};
+                    \"${chart_name} ${chart_version}\", Text(kFrame), Text(kRotorTemplate), Text(kRotorScript)};
 }
 
 }  // namespace cheval::report::detail

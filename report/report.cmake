@@ -21,7 +21,8 @@ set(CHEVAL_REPORT_SOURCES
   ${PROJECT_SOURCE_DIR}/src/report/html.cc
   ${PROJECT_SOURCE_DIR}/src/report/distribution.cc
   ${PROJECT_SOURCE_DIR}/src/report/series.cc
-  ${PROJECT_SOURCE_DIR}/src/report/sections.cc)
+  ${PROJECT_SOURCE_DIR}/src/report/sections.cc
+  ${PROJECT_SOURCE_DIR}/src/report/rotor_page.cc)
 
 if(CHEVAL_BUILD_REPORT)
   if(NOT CHEVAL_NPM_EXECUTABLE)
@@ -51,15 +52,19 @@ if(CHEVAL_BUILD_REPORT)
     COMMAND ${CMAKE_COMMAND}
             -DOUTPUT=${report_build}/report_assets.cc
             -DASSETS_HEADER=${PROJECT_SOURCE_DIR}/src/report/assets.h
+            -DFRAME=${report_source}/frame.html
             -DPAGE_TEMPLATE=${report_source}/page.html
             -DPAGE_SCRIPT=${report_source}/charts.js|${report_source}/report.js
             -DPAGE_STYLE=${report_source}/report.css
             -DCHART_SCRIPT=${uplot}/dist/uPlot.iife.min.js
             -DCHART_STYLE=${uplot}/dist/uPlot.min.css
             -DCHART_PACKAGE=${uplot}/package.json
+            -DROTOR_TEMPLATE=${report_source}/rotors.html
+            -DROTOR_SCRIPT=${report_source}/charts.js|${report_source}/rotors.js
             -P ${report_source}/embed_assets.cmake
     DEPENDS ${CHEVAL_REPORT_NODE_MODULES}/.package-lock.json ${report_source}/embed_assets.cmake
             ${report_source}/page.html ${report_source}/charts.js ${report_source}/report.js ${report_source}/report.css
+            ${report_source}/frame.html ${report_source}/rotors.html ${report_source}/rotors.js
     COMMENT "Embedding the report page and uPlot"
     VERBATIM)
   list(APPEND CHEVAL_REPORT_SOURCES ${report_build}/report_assets.cc)

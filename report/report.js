@@ -5,7 +5,7 @@
 'use strict';
 
 (function () {
-  const { relayout, charts, palette, el, finite, extent, chartBox, lineChart, pathChart, svgChart } = ChevalCharts;
+  const { drawPage, relayout, palette, el, finite, extent, chartBox, lineChart, pathChart, svgChart } = ChevalCharts;
   const data = JSON.parse(document.getElementById('cheval-data').textContent);
   const reference = { color: '#1f2328', chebyshev: '#1f2328', central: '#8c959f', given: '#bf8700' };
   const timeLabel = data.time_axis === 's' ? 'time (s)' : 'pose index';
@@ -379,8 +379,7 @@
     draw();
   }
 
-  window.chevalReport = { charts, data };
-  try {
+  drawPage(data, () => {
     header();
     table();
     trajectories();
@@ -390,11 +389,5 @@
     rpe();
     velocity();
     fit();
-    relayout();
-    window.addEventListener('resize', relayout);
-    document.body.dataset.ready = String(charts.length);
-  } catch (error) {
-    document.body.dataset.error = String(error && error.stack ? error.stack : error);
-    throw error;
-  }
+  });
 })();

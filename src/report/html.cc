@@ -66,22 +66,26 @@ void RequireReportPage() {
   }
 }
 
-std::string RenderReportHtml(std::string_view data_json, std::string_view title) {
+namespace detail {
+
+std::string RenderPage(std::string_view body, std::string_view page_script, std::string_view data_json,
+                       std::string_view title) {
   RequireReportPage();
-  const detail::PageAssets assets = *detail::EmbeddedPageAssets();
+  const PageAssets assets = *EmbeddedPageAssets();
   const std::pair<std::string_view, std::string> values[] = {
       {"TITLE", EscapeHtml(title)},
+      {"BODY", std::string(body)},
       {"CHART_LIBRARY", EscapeHtml(assets.chart_library)},
       {"CHART_STYLE", std::string(assets.chart_style)},
       {"PAGE_STYLE", std::string(assets.page_style)},
       {"CHART_SCRIPT", std::string(assets.chart_script)},
-      {"PAGE_SCRIPT", std::string(assets.page_script)},
+      {"PAGE_SCRIPT", std::string(page_script)},
       {"DATA", EscapeJsonForScript(data_json)},
   };
   // One pass over the template: a marker's value is never scanned for markers itself.
-  const std::string_view page = assets.page_template;
+  const std::string_view page = assets.frame;
   std::string out;
-  out.reserve(page.size() + data_json.size() + assets.chart_script.size() + assets.page_script.size() + 4096);
+  out.reserve(page.size() + body.size() + data_json.size() + assets.chart_script.size() + page_script.size() + 4096);
   size_t at = 0;
   while (true) {
     const size_t open = page.find("{{", at);
@@ -99,6 +103,14 @@ std::string RenderReportHtml(std::string_view data_json, std::string_view title)
   }
   out.append(page.substr(at));
   return out;
+}
+
+}  // namespace detail
+
+std::string RenderReportHtml(std::string_view data_json, std::string_view title) {
+  RequireReportPage();
+  const detail::PageAssets assets = *detail::EmbeddedPageAssets();
+  return detail::RenderPage(assets.page_template, assets.page_script, data_json, title);
 }
 
 }  // namespace cheval::report

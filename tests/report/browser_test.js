@@ -9,7 +9,8 @@
 // error, the velocity is scaled to the motion with central differences one click away, the fit
 // diagnostics are collapsed, every chart exports PNG/SVG/CSV, the table shows the embedded numbers
 // and the missing velocity is said on the page; then takes a full-page screenshot and one per
-// section (the figures of docs/report.md).
+// section (the figures of docs/report.md). Then the rotor page of `cheval estimate rotors --report` on
+// a real flight ($CHEVAL_DATA_DIR), its four motors' charts (rotorPage).
 //
 //   node browser_test.js CHEVAL_EXE NODE_MODULES OUTPUT_DIR
 //
@@ -249,9 +250,59 @@ async function main() {
     const demoCharts = await tab.$$eval('.chart', (boxes) => boxes.map((b) => ({ id: b.dataset.chart, points: Number(b.dataset.points || 0) })));
     check(JSON.stringify(demoCharts.map((c) => c.id)) === JSON.stringify(expected), `the demo report has every chart (${demoCharts.map((c) => c.id).join(', ')})`);
     for (const c of demoCharts) check(c.points > 0, `demo report: chart ${c.id} has data (${c.points} points)`);
+
+    await rotorPage(tab, problems);
   } finally {
     await context.close();
   }
+}
+
+// The page of `cheval estimate rotors --report` on a real Crazyflie flight ($CHEVAL_DATA_DIR; absent:
+// skipped, a failure in CI): the four motors' charts drawn with three series each, the non-scored
+// spans shaded, the table equal to the errors of --json, every chart exporting.
+async function rotorPage(tab, problems) {
+  const flight = path.join(process.env.CHEVAL_DATA_DIR || '', 'crazyflie_brushless_idsia', 'square_20251017_run1.csv');
+  if (!fs.existsSync(flight)) {
+    check(process.env.CI !== 'true', `the rotor page: ${flight} not found (skipped outside CI)`);
+    return;
+  }
+  const vehicle = path.join(__dirname, '..', '..', 'data', 'vehicles', 'crazyflie21_brushless.json');
+  run('estimate', 'rotors', '--data', flight, '--vehicle', vehicle, '--json', 'rotors.json', '--report', 'rotors.html');
+  const json = JSON.parse(fs.readFileSync(path.join(work, 'rotors.json'), 'utf8'));
+  problems.length = 0;
+  await tab.goto('file://' + path.join(work, 'rotors.html'));
+  await tab.waitForSelector('body[data-ready], body[data-error]', { timeout: 30000 });
+  const error = await tab.getAttribute('body', 'data-error');
+  check(error === null, `the rotor page's script ran without an exception${error ? ': ' + error : ''}`);
+  check(problems.length === 0, `the rotor page: no console error or warning, no request${problems.length ? ': ' + problems.join('; ') : ''}`);
+  const html = await tab.content();
+  check(!html.includes(process.env.CHEVAL_DATA_DIR) && !html.includes(work), 'the rotor page has no absolute path');
+  const charts = await tab.evaluate(() => window.chevalReport.charts.map((c) => ({
+    id: c.id, points: c.points, canvas: !!c.box.querySelector('canvas'),
+    series: c.chart.series.slice(1).map((s) => s.label), drawn: c.chart.data.slice(1).map((y) => y.filter((v) => v !== null).length),
+  })));
+  const ids = ['rotor-m1', 'rotor-m2', 'rotor-m3', 'rotor-m4'];
+  check(JSON.stringify(charts.map((c) => c.id)) === JSON.stringify(ids), `the rotor page's charts are ${ids.join(', ')} (got ${charts.map((c) => c.id).join(', ')})`);
+  for (const c of charts) {
+    check(c.canvas && c.points > 0 && JSON.stringify(c.series) === JSON.stringify(['measured', 'cheval', 'flatness baseline']) && c.drawn.every((n) => n > 100),
+      `chart ${c.id} draws measured, cheval and the baseline (${c.drawn.join(', ')} points)`);
+  }
+  const data = await tab.evaluate(() => window.chevalReport.data);
+  check(data.motors.every((m) => m.series.t.length <= data.max_points && m.series.n === data.samples),
+    `each motor's series has at most ${data.max_points} points of ${data.samples} samples (${data.motors.map((m) => m.series.t.length)})`);
+  const shown = await tab.$$eval('#table tbody tr', (rows) => rows.map((r) => [...r.querySelectorAll('td[data-key]')].map((c) => [c.dataset.key, c.textContent])));
+  const expectedTable = json.rotor_error_percent.map((p, m) => [['error.rpm', json.rotor_error_rpm[m].toFixed(1)], ['error.percent', p.toFixed(3)],
+    ['baseline.rpm', json.flatness_error_rpm[m].toFixed(1)], ['baseline.percent', json.flatness_error_percent[m].toFixed(3)]]);
+  check(JSON.stringify(shown) === JSON.stringify(expectedTable), `the rotor table shows the errors of --json (${JSON.stringify(shown)})`);
+  const svg = await tab.evaluate(() => window.chevalReport.charts[0].svg());
+  check(data.unscored.length > 0 && (svg.match(/fill-opacity="0.15"/g) || []).length === data.unscored.length,
+    `the ${data.unscored.length} non-scored span(s) are shaded in the exported SVG`);
+  const exports = await tab.evaluate(async () => Promise.all(window.chevalReport.charts.map(async (c) => {
+    const png = await ChevalCharts.pngOf(c.svg());
+    return { id: c.id, svg: c.svg().split('<path').length - 1, csv: c.csv().trim().split('\n').length, png: png.size };
+  })));
+  for (const e of exports) check(e.svg === 3 && e.csv > 100 && e.png > 3000, `${e.id} exports: SVG ${e.svg} lines, CSV ${e.csv} lines, PNG ${e.png} B`);
+  await tab.screenshot({ path: path.join(outputDir, 'rotors.png'), fullPage: true });
 }
 
 main()

@@ -9,6 +9,7 @@
 
 #include "cheval/common/error.h"
 #include "cheval/estim/rotor_estimator.h"
+#include "cheval/report/rotor_page.h"
 #include "common.h"
 
 namespace cheval::cli {
@@ -17,6 +18,7 @@ namespace {
 struct RotorFlags {
   std::vector<std::string> data;
   std::string vehicle, json, output;
+  std::string report;  // estimate rotors --report
   estim::RotorEstimateOptions options;
 };
 
@@ -63,10 +65,14 @@ void RegisterEstimateRotors(CLI::App& app, Action* action) {
       ->capture_default_str();
   rotors->add_option("--json", flags->json, "Write the result as JSON");
   rotors->add_option("-o,--output", flags->output, "Write states and rotor speeds (estimated, measured, baseline) as CSV");
+  rotors->add_option("--report", flags->report,
+                     "Write an HTML page: estimated, measured and baseline speed per motor over time, error table");
   rotors->callback([flags, action] {
     *action = [flags] {
       flags->options.Validate();
-      RefuseSharedPaths({flags->data[0], flags->vehicle}, {{"--json", flags->json}, {"-o", flags->output}});
+      if (!flags->report.empty()) report::RequireReportPage();
+      RefuseSharedPaths({flags->data[0], flags->vehicle},
+                        {{"--json", flags->json}, {"-o", flags->output}, {"--report", flags->report}});
       const estim::RotorVehicle vehicle = estim::ReadRotorVehicle(flags->vehicle);
       const estim::RotorFlight flight = estim::ReadRotorFlight(flags->data[0]);
       if (!flight.dropped_lines.empty()) {
@@ -87,6 +93,11 @@ void RegisterEstimateRotors(CLI::App& app, Action* action) {
       std::vector<OutputFile> files;
       if (!flags->json.empty()) files.push_back({flags->json, json});
       if (!flags->output.empty()) files.push_back({flags->output, csv});
+      const std::string page =
+          flags->report.empty() ? "" : report::RotorPageHtml(e, {.flight_path = flags->data[0],
+                                                                 .vehicle_path = flags->vehicle,
+                                                                 .generator = fmt::format("cheval {}", CHEVAL_VERSION)});
+      if (!flags->report.empty()) files.push_back({flags->report, page});
       if (!files.empty()) WriteOutputs(files);
     };
   });
