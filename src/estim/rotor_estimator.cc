@@ -188,9 +188,6 @@ void AddDynamics(Problem& problem, const RotorModel& model, const RotorEstimateO
       problem.AddPrior(std::make_unique<Dynamics>(model.nominal, segment, D, j, 2, o.sigma_angular_acceleration, theta));
     }
   }
-  for (int n = 0; n < problem.num_nodes(); ++n) {  // a rotor does not turn backwards
-    for (int i = 0; i < 4; ++i) problem.ceres_problem().SetParameterLowerBound(problem.Control(n), i, 0.0);
-  }
 }
 
 ceres::Solver::Options SolverOptions(const RotorEstimateOptions& o) {
