@@ -136,6 +136,10 @@ TEST(RotorEstimator, EstimateReachesSimulatedAccuracy) {
   }
   EXPECT_GT(e.scored_samples, 600);
   EXPECT_NEAR(e.duration_s, 8.0, 0.02);
+  estim::RotorEstimateOptions one_thread;  // the default uses every core; the result is the same
+  one_thread.threads = 1;
+  const estim::RotorEstimate single = estim::EstimateRotors(flight, SimRotorVehicle(), one_thread);
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(single.error.percent[i], e.error.percent[i], 1e-9) << i;
 }
 
 // Identification from a base vehicle with wrong published values recovers the true ones; J_z, which

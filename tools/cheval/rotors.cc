@@ -35,6 +35,7 @@ void AddModelOptions(CLI::App* command, estim::RotorEstimateOptions& o) {
   command->add_option("--sigma-angular-acceleration", o.sigma_angular_acceleration,
                       "Collocation sigma of the body rate's derivative (rad/s^2)")
       ->capture_default_str();
+  command->add_option("--threads", o.threads, "Solver threads (default: the machine's cores)")->capture_default_str();
   command->add_option("--max-iterations", o.max_iterations, "Levenberg-Marquardt iterations at most")
       ->capture_default_str();
   command->add_option("--baseline-window", o.baseline_window_s, "Window of the flatness baseline's fits (s)")
