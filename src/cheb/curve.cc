@@ -33,6 +33,11 @@ constexpr double kLackOfFitLimit = 3.0;
 // hundreds of samples a χ² test alone would take for unresolved motion (it made the drone's body
 // rate 2–3x worse); a residual of 1.5σ (a missed tremor) still fails.
 constexpr double kNoiseMargin = 1.1;
+// A window that passes the lack-of-fit test with a score above this (2 standard deviations, where
+// noise consistent with the 1.1σ margin rarely comes) is compared with its halves
+// (SplitPredictsBetter). At 1 the charts of rotations, whose noise varies along them, were split
+// where that did not help (docs/decisions.md).
+constexpr double kSplitScore = 2.0;
 // End windows are halved (RefineEnds) while they keep this many samples on each side.
 constexpr Eigen::Index kMinEndWindowSamples = 24;
 using internal::kMaxGramCondition;
@@ -46,7 +51,10 @@ class WindowFitter {
 
   // Fits the window of core [a, b] inside segment [segment_begin, segment_end]. Returns nullopt
   // when the series is not resolved and splitting is allowed.
-  std::optional<CurveWindow> Fit(double a, double b, double segment_begin, double segment_end, bool may_split) const {
+  // With `held_out`, a cross-validated window also gives its held-out squared error per sample and
+  // coordinate at its cross-validated degrees (empty for the other methods).
+  std::optional<CurveWindow> Fit(double a, double b, double segment_begin, double segment_end, bool may_split,
+                                 Eigen::VectorXd* held_out = nullptr) const {
     const double extension = options_.overlap * (b - a);
     CurveWindow window;
     window.core_begin = a;
@@ -138,7 +146,12 @@ class WindowFitter {
     // The chop looks for a plateau by shape, which a short noisy window can hide: when the top third
     // of the coefficients is statistically pure noise, the window is resolved anyway.
     if (!resolved) resolved = TailIsNoise(high, *cholesky);
-    if (cross_validate && (resolved || !may_split)) window.degrees = CrossValidatedDegrees(*folds, top);
+    if (held_out != nullptr) held_out->resize(0);
+    if (cross_validate && (resolved || !may_split)) {
+      Eigen::VectorXd error;
+      window.degrees = CrossValidatedDegrees(*folds, top, &error);
+      if (held_out != nullptr) *held_out = error / static_cast<double>(m);
+    }
     if (!resolved && may_split) return std::nullopt;
 
     // The residual must be consistent with the noise too: a series can look resolved while the
@@ -390,7 +403,7 @@ class WindowFitter {
   // and the held-out error of coefficients c is Σz²_f - 2 cᵀb_f + cᵀG_f c. Each fold's training
   // system is factorised once; each candidate degree is then two triangular solves of a leading
   // block.
-  static std::vector<int> CrossValidatedDegrees(const Folds& folds, int top) {
+  static std::vector<int> CrossValidatedDegrees(const Folds& folds, int top, Eigen::VectorXd* best_error) {
     const std::vector<int> grid = DegreeGrid(top);
     const Eigen::Index d = folds.total.rhs.cols();
     Eigen::MatrixXd error = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(grid.size()), d);
@@ -425,9 +438,10 @@ class WindowFitter {
       }
     }
     std::vector<int> degrees(static_cast<size_t>(d));
+    best_error->resize(d);
     for (Eigen::Index c = 0; c < d; ++c) {
       Eigen::Index best = 0;
-      error.col(c).minCoeff(&best);
+      (*best_error)[c] = error.col(c).minCoeff(&best);
       degrees[static_cast<size_t>(c)] = grid[static_cast<size_t>(best)];
     }
     return degrees;
@@ -438,6 +452,26 @@ class WindowFitter {
   const Eigen::VectorXd& sigma_;
   const CurveOptions& options_;
 };
+
+// A window accepted while its residual is above the noise (lack-of-fit score above kSplitScore in
+// some coordinate) may still miss motion above its top degree that the test cannot prove at its
+// length. Its two halves are fitted too, and it is split when they predict held-out samples better:
+// their cross-validated squared error per sample, relative to the window's own and averaged over
+// the coordinates, is below 1 (no σ is involved).
+bool SplitPredictsBetter(const WindowFitter& fitter, const CurveWindow& window, const Eigen::VectorXd& held_out,
+                         const CurveSegment& segment, const CurveOptions& options) {
+  if (options.degree_method != DegreeMethod::kCrossValidation || !options.lack_of_fit || held_out.size() == 0) {
+    return false;
+  }
+  if (!(window.lack_of_fit.maxCoeff() > kSplitScore) || !(held_out.minCoeff() > 0.0)) return false;
+  const double middle = 0.5 * (window.core_begin + window.core_end);
+  Eigen::VectorXd left_error, right_error;
+  const CurveWindow left = *fitter.Fit(window.core_begin, middle, segment.begin, segment.end, false, &left_error);
+  const CurveWindow right = *fitter.Fit(middle, window.core_end, segment.begin, segment.end, false, &right_error);
+  const double m_left = static_cast<double>(left.samples), m_right = static_cast<double>(right.samples);
+  const Eigen::VectorXd halves = (m_left * left_error + m_right * right_error) / (m_left + m_right);
+  return halves.cwiseQuotient(held_out).mean() < 1.0;
+}
 
 // Fits cores [a, b] of a segment adaptively: a core is halved until its series resolves or it
 // gets too small to split. Windows come out in time order.
@@ -451,7 +485,9 @@ std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::Ve
     const auto inside =
         std::upper_bound(t.data(), t.data() + t.size(), b) - std::lower_bound(t.data(), t.data() + t.size(), a);
     const bool may_split = inside >= 2 * options.min_window_samples;
-    std::optional<CurveWindow> window = fitter.Fit(a, b, segment.begin, segment.end, may_split);
+    Eigen::VectorXd held_out;
+    std::optional<CurveWindow> window = fitter.Fit(a, b, segment.begin, segment.end, may_split, &held_out);
+    if (window && may_split && SplitPredictsBetter(fitter, *window, held_out, segment, options)) window.reset();
     if (!window) {
       const double middle = 0.5 * (a + b);
       stack.emplace_back(middle, b);  // the left half is popped first: windows stay in time order
