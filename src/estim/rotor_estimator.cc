@@ -220,8 +220,8 @@ void RotorEstimateOptions::Validate() const {
   check(positive(sigma_rotation_rate), "sigma_rotation_rate", "must be > 0, got {}", sigma_rotation_rate);
   check(positive(sigma_rotor_rate), "sigma_rotor_rate", "must be > 0, got {}", sigma_rotor_rate);
   check(positive(baseline_window_s), "baseline_window_s", "must be > 0, got {}", baseline_window_s);
-  check(positive(identification_piece_s), "identification_piece_s", "must be a positive number of seconds, got {}",
-        identification_piece_s);
+  check(identification_piece_s >= 1 && std::isfinite(identification_piece_s), "identification_piece_s",
+        "must be at least 1 s, got {}", identification_piece_s);
   check(score_margin_s >= 0 && std::isfinite(score_margin_s), "score_margin_s", "must be >= 0, got {}", score_margin_s);
   check(positive(function_tolerance), "function_tolerance", "must be > 0, got {}", function_tolerance);
   check(max_iterations >= 1, "max_iterations", "must be >= 1, got {}", max_iterations);

@@ -203,6 +203,17 @@ TEST(RotorIdentification, CombinationWidensSigmaByTheDispersion) {
   EXPECT_THROW(estim::CombineIdentifications({}), UsageError);
 }
 
+TEST(RotorEstimateOptions, RefusesOutOfRangeFields) {
+  estim::RotorEstimateOptions o;
+  EXPECT_NO_THROW(o.Validate());
+  o.identification_piece_s = 0.5;  // pieces shorter than a second would hold a few segments at most
+  EXPECT_THROW(o.Validate(), OptionError);
+  o = {};
+  o.threads = 0;
+  EXPECT_THROW(o.Validate(), OptionError);
+  EXPECT_GE(estim::RotorEstimateOptions{}.threads, 1);
+}
+
 TEST(RotorVehicleFile, RoundTripAndErrors) {
   const fs::path dir = fs::temp_directory_path() /
                        ("cheval_rotor_vehicle_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));

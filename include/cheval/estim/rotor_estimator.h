@@ -51,7 +51,7 @@ struct RotorEstimateOptions {
   /// rotor error on each of the three Crazyflie flights is least at 700–1000 (docs/estimator_real_data.md).
   double sigma_rotor_rate = 1000.0;
   double baseline_window_s = 0.2;  ///< window of the flatness baseline's local fits, s (> 0)
-  /// Identification: each flying span is cut into pieces of about this length (s, > 0; a shorter
+  /// Identification: each flying span is cut into pieces of about this length (s, >= 1; a shorter
   /// span is one piece), identified one by one; their spread enters θ's σ (IdentifyRotors).
   double identification_piece_s = 8.0;
   double score_margin_s = 0.5;     ///< scored samples: flying, this far from a span's ends (>= 0)
