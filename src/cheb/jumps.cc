@@ -129,7 +129,9 @@ class SlopeScan {
   // Where exactly the motion jumps near slope j (a jump inside [t_b, t_{b+1}] makes slope b a
   // mix of the two sides, which its neighbours' lines may not single out): the boundary b among
   // j − 4 .. j + 4 whose removal leaves the straightest lines on either side (least squared
-  // residuals of a line through kSide slopes on each side, in local scales).
+  // residuals of a line through kSide slopes on each side, in local scales). A boundary with fewer
+  // than 3 slopes on a side cannot be judged and is not chosen: near the ends of the data it would
+  // win by having no residual there, and cut off a piece of a few samples.
   Eigen::Index LocateBreak(Eigen::Index j, const Eigen::MatrixXd& scale) const {
     Eigen::Index best = j;
     double best_cost = std::numeric_limits<double>::infinity();
@@ -145,14 +147,15 @@ class SlopeScan {
  private:
   // Σ over coordinates of the squared residuals (in local scales) of the least-squares line
   // through up to kSide usable slopes next to boundary b in `direction` (slope b itself excluded),
-  // with the local scale at slope `at` (one scale for every b compared).
+  // with the local scale at slope `at` (one scale for every b compared); infinity with fewer than
+  // 3 such slopes.
   double LineResidual(Eigen::Index b, int direction, const Eigen::MatrixXd& scale, Eigen::Index at) const {
     std::vector<Eigen::Index> used;
     for (Eigen::Index i = b + direction; i >= 0 && i < n_ && static_cast<int>(used.size()) < kSide; i += direction) {
       if (cut_[static_cast<size_t>(i)]) break;
       if (!masked_[static_cast<size_t>(i)]) used.push_back(i);
     }
-    if (used.size() < 3) return 0.0;
+    if (used.size() < 3) return std::numeric_limits<double>::infinity();
     double s0 = 0, s1 = 0, s2 = 0;
     for (const Eigen::Index i : used) s0 += 1, s1 += mid_[i], s2 += mid_[i] * mid_[i];
     const double mean_u = s1 / s0, spread = s2 - s1 * mean_u;
@@ -173,7 +176,9 @@ class SlopeScan {
   }
 
   // Least-squares line through up to kSide usable slopes beyond the adjacent one in `direction`,
-  // not crossing a cut, evaluated at slope j's time.
+  // not crossing a cut, evaluated at slope j's time; false with fewer than kSide / 2 slopes (a line
+  // from two or three slopes extrapolates their noise several times over: next to the ends of the
+  // data it flagged plain noise as a jump and cut off the first few samples).
   bool PredictFrom(Eigen::Index j, int direction, Eigen::VectorXd* prediction) const {
     double s0 = 0, s1 = 0, s2 = 0;
     Eigen::VectorXd b0 = Eigen::VectorXd::Zero(d_), b1 = Eigen::VectorXd::Zero(d_);
@@ -188,7 +193,7 @@ class SlopeScan {
       b1 += u * slopes_.row(i).transpose();
       ++count;
     }
-    if (count < 2) return false;
+    if (count < kSide / 2) return false;
     const double determinant = s0 * s2 - s1 * s1;
     if (!(determinant > 1e-12 * s2 * s0)) {
       *prediction = b0 / s0;
