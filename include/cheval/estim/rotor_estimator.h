@@ -78,11 +78,11 @@ struct RotorError {
 /// The estimate at one sample of the flight.
 struct RotorStateEstimate {
   double t = 0;
-  Eigen::Vector3d p, v, w;
-  Eigen::Quaterniond q;
-  Eigen::Vector4d rotor;     ///< estimated m1..m4, rad/s
-  Eigen::Vector4d measured;  ///< the flight's, rad/s
-  Eigen::Vector4d baseline;  ///< the flatness baseline's, rad/s
+  Eigen::Vector3d p = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero(), w = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  Eigen::Vector4d rotor = Eigen::Vector4d::Zero();     ///< estimated m1..m4, rad/s
+  Eigen::Vector4d measured = Eigen::Vector4d::Zero();  ///< the flight's, rad/s
+  Eigen::Vector4d baseline = Eigen::Vector4d::Zero();  ///< the flatness baseline's, rad/s
   bool scored = false;       ///< in the scored samples
 };
 
