@@ -90,6 +90,19 @@ TEST_F(RotorsCliTest, MissingColumnIsExit2NamingFileAndLine) {
   ExpectNoOutputs();
 }
 
+// An option out of its range is exit 1, named by its flag (not the library's field).
+TEST_F(RotorsCliTest, OptionOutOfRangeIsExit1NamingTheFlag) {
+  const std::string flight = WriteHover("hover.csv");
+  RunResult r = Cheval(fmt::format("estimate rotors --data {} --vehicle {} --degree 1 {}", flight, kVehicle, Outputs()));
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("--degree must be in [2, 20], got 1"), std::string::npos) << r.err;
+  ExpectNoOutputs();
+  r = Cheval(fmt::format("identify rotors --data {} --vehicle {} --piece 0.5 -o {}", flight, kVehicle, Path("v.json")));
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("--piece must be at least 1 s, got 0.5"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(Path("v.json")));
+}
+
 TEST_F(RotorsCliTest, MissingVehicleFileIsExit2) {
   const std::string flight = WriteHover("hover.csv");
   const RunResult r = Cheval(

@@ -81,6 +81,20 @@ constexpr std::array kFlags = std::to_array<OptionName>({
     {"ThrustEstimateOptions::sigma_acceleration", "--sigma-acceleration"},
     {"ThrustEstimateOptions::sigma_rotor_rate", "--sigma-rotor-rate"},
     {"ThrustEstimateOptions::rotor_delay_s", "--rotor-delay"},
+    // estim::RotorEstimateOptions
+    {"RotorEstimateOptions::degree", "--degree"},
+    {"RotorEstimateOptions::segment_s", "--segment"},
+    {"RotorEstimateOptions::position_sigma_m", "--position-sigma"},
+    {"RotorEstimateOptions::attitude_sigma_rad", "--attitude-sigma"},
+    {"RotorEstimateOptions::rate_sigma_radps", "--rate-sigma"},
+    {"RotorEstimateOptions::rotor_sigma_radps", "--rotor-sigma"},
+    {"RotorEstimateOptions::sigma_acceleration", "--sigma-acceleration"},
+    {"RotorEstimateOptions::sigma_angular_acceleration", "--sigma-angular-acceleration"},
+    {"RotorEstimateOptions::sigma_rotor_rate", "--sigma-rotor-rate"},
+    {"RotorEstimateOptions::baseline_window_s", "--baseline-window"},
+    {"RotorEstimateOptions::identification_piece_s", "--piece"},
+    {"RotorEstimateOptions::max_iterations", "--max-iterations"},
+    {"RotorEstimateOptions::threads", "--threads"},
 });
 
 // evo's spellings (evo_ape / evo_rpe / evo_traj 1.36.5 argparse names), one table for the CLI's

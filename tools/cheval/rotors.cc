@@ -117,6 +117,9 @@ void RegisterIdentifyRotors(CLI::App& app, Action* action) {
   AddModelOptions(rotors, flags->options);
   rotors->add_option("--rotor-sigma", flags->options.rotor_sigma_radps, "Sigma of a measured rotor speed (rad/s)")
       ->capture_default_str();
+  rotors->add_option("--piece", flags->options.identification_piece_s,
+                     "Length of the pieces identified one by one (s, >= 1); their spread widens sigma")
+      ->capture_default_str();
   rotors->callback([flags, action] {
     *action = [flags] {
       std::vector<std::string> inputs = flags->data;
