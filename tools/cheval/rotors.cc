@@ -3,6 +3,7 @@
 // vehicle's parameters from flights with measured rotor speeds (docs/estimator_real_data.md).
 #include <fmt/format.h>
 
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
@@ -140,7 +141,12 @@ void RegisterIdentifyRotors(CLI::App& app, Action* action) {
                              "Jz/Jz_pub", "k_M/Kc", "tau0_x [1e-5 N m]", "tau0_y [1e-5 N m]",
                              "tau0_z [1e-5 N m]", "drag_xy [1e-5]", "drag_z [1e-5]", "moment_x [1e-8]",
                              "moment_y [1e-8]", "rotor_inertia [1e-9 kg m^2]"};
+      static_assert(std::size(names) == estim::kRotorThetaSize);
       for (int i = 0; i < estim::kRotorThetaSize; ++i) {
+        if (out.theta_sigma[i] == 0) {
+          fmt::print("{:<20}{:>10.4f}   (held at the base vehicle's value)\n", names[i], out.theta[i]);
+          continue;
+        }
         fmt::print("{:<20}{:>10.4f} +- {:.4f}   (published {})\n", names[i], out.theta[i], out.theta_sigma[i],
                    estim::RotorNominal::PublishedTheta()[i]);
       }
