@@ -318,7 +318,17 @@ RotorIdentification IdentifyPiece(const RotorFlight& flight, size_t first, size_
                                    "problem is rank-deficient)",
                                    flight.path));
   }
-  covariance.GetCovarianceBlock(theta.data(), theta.data(), id.covariance.data());
+  // In θ's tangent (J_z held: one entry fewer), spread into θ with zeros for the held entry. The
+  // ambient-space getter lifts through Eigen temporaries inside Ceres, whose heap blocks an
+  // AddressSanitizer build of cheval allocates and frees with two different alignments.
+  constexpr int kFree = kRotorThetaSize - 1;
+  Eigen::Matrix<double, kFree, kFree, Eigen::RowMajor> tangent;
+  covariance.GetCovarianceBlockInTangentSpace(theta.data(), theta.data(), tangent.data());
+  id.covariance.setZero();
+  const auto ambient = [](int k) { return k < kThetaInertiaX + 2 ? k : k + 1; };
+  for (int a = 0; a < kFree; ++a) {
+    for (int b = 0; b < kFree; ++b) id.covariance(ambient(a), ambient(b)) = tangent(a, b);
+  }
   id.reduced_chi2 =
       2.0 * summary.final_cost / std::max(1, summary.num_residuals_reduced - summary.num_effective_parameters_reduced);
   id.covariance *= std::max(1.0, id.reduced_chi2);
