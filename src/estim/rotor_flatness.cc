@@ -136,10 +136,9 @@ RotorError ScoreRotors(const RotorFlight& flight, const std::vector<Eigen::Vecto
   if (estimate.size() != flight.samples.size()) throw UsageError("one estimate per sample of the flight is needed");
   RotorError e;
   if (indices.empty()) throw ComputeError("no samples to score (no flying span longer than the margins)");
-  constexpr double kRadpsToRpm = 60.0 / (2.0 * M_PI);
   for (size_t i : indices) {
     const Eigen::Vector4d d = (estimate[i] - flight.samples[i].rotor).cwiseAbs();
-    e.rpm += d * kRadpsToRpm;
+    e.rpm += d * kRpmPerRadps;
     e.percent += 100.0 * d.cwiseQuotient(flight.samples[i].rotor.cwiseMax(1e-9));
   }
   e.rpm /= static_cast<double>(indices.size());

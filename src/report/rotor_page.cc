@@ -1,7 +1,6 @@
 #include "cheval/report/rotor_page.h"
 
 #include <filesystem>
-#include <numbers>
 #include <string>
 #include <utility>
 #include <vector>
@@ -18,8 +17,6 @@ namespace cheval::report {
 namespace {
 
 using detail::Json;
-
-constexpr double kRpmPerRadps = 30.0 / std::numbers::pi;
 
 std::string FileName(const std::string& path) { return std::filesystem::path(path).filename().string(); }
 
@@ -89,9 +86,9 @@ std::string RotorPageData(const estim::RotorEstimate& estimate, const RotorPageO
                                {"baseline", std::vector<double>(n)}};
     for (size_t i = 0; i < n; ++i) {
       const estim::RotorStateEstimate& s = estimate.samples[i];
-      columns[0].second[i] = s.rotor[m] * kRpmPerRadps;
-      columns[1].second[i] = s.measured[m] * kRpmPerRadps;
-      columns[2].second[i] = s.baseline[m] * kRpmPerRadps;
+      columns[0].second[i] = s.rotor[m] * estim::kRpmPerRadps;
+      columns[1].second[i] = s.measured[m] * estim::kRpmPerRadps;
+      columns[2].second[i] = s.baseline[m] * estim::kRpmPerRadps;
     }
     Json motor;
     motor["name"] = fmt::format("m{}", m + 1);

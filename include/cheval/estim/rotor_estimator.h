@@ -6,6 +6,7 @@
 /// baseline they are compared with (docs/estimator_real_data.md, "Rotor speeds of a Crazyflie").
 
 #include <algorithm>
+#include <numbers>
 #include <string>
 #include <thread>
 #include <vector>
@@ -68,6 +69,9 @@ struct RotorEstimateOptions {
   /// Throws OptionError naming the first field out of its range.
   void Validate() const;
 };
+
+/// Revolutions per minute in one rad/s: the rotor speeds are rad/s inside, rpm where people read them.
+inline constexpr double kRpmPerRadps = 30.0 / std::numbers::pi;
 
 /// Per-motor mean absolute error over the scored samples.
 struct RotorError {
