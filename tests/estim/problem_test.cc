@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <Eigen/Core>
 
+#include "../support/residual_only.h"
 #include "cheval/cheb/chebyshev.h"
 #include "cheval/common/error.h"
 #include "cheval/estim/models.h"
@@ -320,6 +321,24 @@ TEST(PseudoSpectralProblem, MeasurementWithoutRotationKeepsNormalEquations) {
   EXPECT_LT((a.gradient - b.gradient).cwiseAbs().maxCoeff(), 1e-12 * b.gradient.cwiseAbs().maxCoeff());
   EXPECT_LT((a.JtJ - b.JtJ).cwiseAbs().maxCoeff(), 1e-12 * b.JtJ.cwiseAbs().maxCoeff());
   ExpectGradientMatchesDifferences(without);
+}
+
+// A measurement evaluated alone (Ceres pricing a step: doubles) costs what it costs linearised
+// (ceres::Jet): compressed and not, with and without a loss, with and without the rotation.
+TEST(PseudoSpectralProblem, MeasurementCostsTheSameWithAndWithoutJacobians) {
+  const PointObservation obs{{{1, 2, 3}, {-1, 0.5, 2}, {0.3, -2, 1}, {2, 2, -1}}};
+  ceres::HuberLoss loss(0.3);
+  auto problem = AttitudeProblem(6, false);
+  problem.AddMeasurement(0.37, obs, 12, 3, {0}, &loss);                      // compressed
+  problem.AddMeasurement(1.61, PointObservation{{obs.points[1]}, 1}, 3, 3, {0}, &loss);  // not
+  problem.AddMeasurement(0.9, VectorObservation{}, 3, 3, {0}, nullptr, false);  // no rotation
+  // Nodes off the trajectory, so that every residual is far from zero.
+  for (int g = 0; g < problem.num_nodes(); ++g) {
+    const StateSample x = problem.Interpolate(problem.NodeTime(g));
+    problem.SetNode(g, x.vector * 1.3 + Eigen::Vector3d(0.1, -0.2, 0.05),
+                    x.rotation * lie::SO3d::Exp(Eigen::Vector3d(0.02 * g, -0.1, 0.3)).Matrix(), x.control);
+  }
+  EXPECT_EQ(cheval::testing::ExpectResidualOnlyEvaluationMatches(problem.ceres_problem()), 3 + 2 * 7 * 2);
 }
 
 TEST(PseudoSpectralProblem, OutsideIntervalIsAnError) {

@@ -8,9 +8,13 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/residual_only.h"
 #include "../support/test_data.h"
 
+#include "cheval/cheb/chebyshev.h"
 #include "cheval/common/error.h"
+#include "cheval/estim/internal/parametric_collocation_cost.h"
+#include "cheval/estim/problem.h"
 #include "cheval/estim/models.h"
 #include "cheval/estim/rotor_estimator.h"
 #include "cheval/estim/vehicle.h"
@@ -123,6 +127,40 @@ TEST(RotorModel, RotorReactionConservesAngularMomentum) {
   // The rotors' momentum changes by |c_r ΔY| = 3e-8 · 0.2 · 5300 ≈ 3.2e-5; the body takes it all.
   EXPECT_LT((L1 - L0).norm(), 1e-3 * std::abs(c_r * 0.2 * 5300)) << (L1 - L0).transpose();
   EXPECT_GT((J.cwiseProduct(w) - J.cwiseProduct(Eigen::Vector3d(1.5, -2.0, 0.7))).norm(), 0.3 * std::abs(c_r * 0.2 * 5300));
+}
+
+// The v' and ω' defects, with θ known and θ a parameter block, cost the same evaluated alone (Ceres
+// pricing a step: doubles) and linearised (ceres::Jet), at nodes where every term is far from zero.
+TEST(RotorModel, DefectsCostTheSameWithAndWithoutJacobians) {
+  estim::RotorVehicle v = SimRotorVehicle();
+  v.theta[estim::kThetaDragXY] = 3;
+  v.theta[estim::kThetaDragZ] = 2;
+  v.theta[estim::kThetaFlapX] = 5;
+  v.theta[estim::kThetaRotorInertia] = -7;
+  const int degree = 5;
+  estim::PseudoSpectralProblem<estim::RotorModel> problem({v.nominal, v.theta}, {0.0, 0.25, 0.5}, degree);
+  for (int g = 0; g < problem.num_nodes(); ++g) {
+    const double t = problem.NodeTime(g);
+    Eigen::VectorXd x(9);
+    x << t, 2 * t, -t, 1 + t, -0.5, 0.3 * t, 0.2 + t, -0.1, 0.4 * t;
+    const Eigen::Vector4d rotors = Eigen::Vector4d(1100, 1180, 1050, 1230) + 400 * t * Eigen::Vector4d(1, -1, 0.5, 2);
+    problem.SetNode(g, x, Eigen::AngleAxisd(0.4 + t, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix(),
+                    rotors);
+  }
+  problem.SetChartReferences();
+  const Eigen::MatrixXd D = cheb::DifferentiationMatrix(degree);
+  estim::RotorThetaVector theta = v.theta;
+  for (int s = 0; s < problem.num_segments(); ++s) {
+    for (int j = 0; j <= degree; ++j) {
+      for (int part : {1, 2}) {
+        problem.AddPrior(std::make_unique<estim::internal::ParametricCollocationCost<false>>(
+            v.nominal, problem.SegmentOf(s), D, j, part, 0.3, theta.data()));
+        problem.AddPrior(std::make_unique<estim::internal::ParametricCollocationCost<true>>(
+            v.nominal, problem.SegmentOf(s), D, j, part, 0.3, theta.data()));
+      }
+    }
+  }
+  EXPECT_EQ(cheval::testing::ExpectResidualOnlyEvaluationMatches(problem.ceres_problem()), 2 * 6 * 2 * 2);
 }
 
 // The flatness inversion with the true vehicle on exact data is close (the fits' window smooths).

@@ -15,7 +15,8 @@
 /// squared norm is meaningful. Parameter blocks: per node of the segment (point order), the used
 /// vector blocks, then the quaternion (models with a rotation, unless the measurement is declared
 /// not to use it: then h's R is the identity, and the node's rotation is none of its blocks). h is differentiated by ceres::Jet in
-/// the local tangent at t and carried to the nodes through the row (rotation: J_r(φ(t)) J_r⁻¹(φ_k)).
+/// the local tangent at t and carried to the nodes through the row (rotation: J_r(φ(t)) J_r⁻¹(φ_k));
+/// without Jacobians (Ceres pricing a step) h is evaluated in doubles.
 
 #include <algorithm>
 #include <cmath>
@@ -76,11 +77,7 @@ class MeasurementCost : public BlockCost {
     Eigen::Matrix<double, kVector, 1> x = Eigen::Matrix<double, kVector, 1>::Zero();
     Eigen::Vector3d phi = Eigen::Vector3d::Zero();
     std::vector<Eigen::Vector3d> phis;
-    std::vector<Eigen::Matrix3d> jr_inv;
-    if (rotation_) {
-      phis.resize(N + 1);
-      jr_inv.resize(N + 1);
-    }
+    if (rotation_) phis.resize(N + 1);
     for (int k = 0; k <= N; ++k) {
       for (int b = 0; b < kBlocks; ++b) {
         const auto it = std::find(used_.begin(), used_.end(), b);
@@ -90,15 +87,15 @@ class MeasurementCost : public BlockCost {
       }
       if (rotation_) {
         phis[k] = ChartVector(reference_, parameters[k * per_node + per_node - 1]);
-        jr_inv[k] = lie::SO3d::InverseRightJacobian(phis[k]);
         phi += row_.w[k] * phis[k];
       }
     }
-    if (jacobians == nullptr && compress_) {
-      // Residual only (Ceres then needs only the cost): h in doubles, and a residual vector with
-      // the same squared norm, (sqrt(Σ ρ), 0, ..., 0).
+    if (jacobians == nullptr) {
+      // Residual only (a step's cost): h in doubles. Compressed, a residual vector with the same
+      // squared norm, (sqrt(Σ ρ), 0, ..., 0).
       Eigen::Matrix3d R_t = Eigen::Matrix3d::Identity();
       if (rotation_) R_t = reference_ * lie::SO3d::Exp(phi).Matrix();
+      if (!compress_) return f_(x.data(), R_t, residuals);
       std::vector<double> h(rows_);
       if (!f_(x.data(), R_t, h.data())) return false;
       double cost = 0.0;
@@ -119,12 +116,14 @@ class MeasurementCost : public BlockCost {
     for (int i = 0; i < kVector; ++i) xj[i] = Jet(x[i], i);
     Eigen::Matrix<Jet, 3, 3> R = Eigen::Matrix<Jet, 3, 3>::Identity();
     Eigen::Matrix3d jr_t = Eigen::Matrix3d::Identity();
-    if (rotation_) {
-      Eigen::Matrix<Jet, 3, 1> delta;
-      for (int i = 0; i < 3; ++i) delta[i] = Jet(0.0, kVector + i);
-      const Eigen::Matrix3d R_t = reference_ * lie::SO3d::Exp(phi).Matrix();
-      R = R_t.cast<Jet>() * lie::SO3<Jet>::Exp(delta).Matrix();
-      jr_t = lie::SO3d::RightJacobian(phi);
+    if constexpr (kRotation) {  // (a model without a rotation has no δ in its tangent)
+      if (rotation_) {
+        Eigen::Matrix<Jet, 3, 1> delta;
+        for (int i = 0; i < 3; ++i) delta[i] = Jet(0.0, kVector + i);
+        const Eigen::Matrix3d R_t = reference_ * lie::SO3d::Exp(phi).Matrix();
+        R = R_t.cast<Jet>() * lie::SO3<Jet>::Exp(delta).Matrix();
+        jr_t = lie::SO3d::RightJacobian(phi);
+      }
     }
     std::vector<Jet> h(rows_);
     if (!f_(xj, R, h.data())) return false;
@@ -186,7 +185,7 @@ class MeasurementCost : public BlockCost {
         double* jac = jacobians[k * per_node + per_node - 1];
         if (jac == nullptr) continue;
         const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> Jd =
-            row_.w[k] * out_J.middleCols(c, 3) * jr_t * jr_inv[k];
+            row_.w[k] * out_J.middleCols(c, 3) * jr_t * lie::SO3d::InverseRightJacobian(phis[k]);
         LiftRotationJacobian(parameters[k * per_node + per_node - 1], Jd.data(), m, jac);
       }
     }

@@ -13,7 +13,8 @@
 /// blocks, its quaternion (x, y, z, w), the control — at the N + 1 nodes for b = 2, at node j for
 /// b = 1 — then θ (kRotorThetaSize) when `kIdentify`; otherwise θ is the constant given. Jacobians
 /// analytic through D; f by ceres::Jet in (x_j, δ_j, u_j, u'_j[, θ]), the rotation's lifted to the
-/// quaternion (LiftRotationJacobian).
+/// quaternion (LiftRotationJacobian). Without Jacobians (Ceres pricing a step) f is evaluated in
+/// doubles, the same residual at a fraction of the cost.
 
 #include <ceres/jet.h>
 #include <Eigen/Core>
@@ -57,6 +58,7 @@ class ParametricCollocationCost : public BlockCost {
   }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    if (jacobians == nullptr) return Defect(parameters, residuals);
     const int N = degree_;
     using Jet = ceres::Jet<double, kJet>;
     Jet x[9], u[4], u_dot[4], theta[kRotorThetaSize], x_dot[9];
@@ -87,11 +89,9 @@ class ParametricCollocationCost : public BlockCost {
     for (int i = 0; i < 3; ++i) delta[i] = Jet(0.0, 9 + i);
     const Eigen::Matrix<Jet, 3, 3> R = QuaternionMatrix(q).cast<Jet>() * lie::SO3<Jet>::Exp(delta).Matrix();
     RotorDynamics(nominal_, x, R, u, u_dot, theta, x_dot);
-    Eigen::Vector3d r;
-    for (int i = 0; i < 3; ++i) r[i] = -x_dot[3 * part_ + i].a;
-    for (int k = 0; k <= N; ++k) r += scale_ * d_[k] * Eigen::Map<const Eigen::Vector3d>(parameters[k]);
-    Eigen::Map<Eigen::Vector3d>{residuals} = inv_sigma_ * r;
-    if (jacobians == nullptr) return true;
+    Eigen::Vector3d f;
+    for (int i = 0; i < 3; ++i) f[i] = x_dot[3 * part_ + i].a;
+    WriteResidual(parameters, f, residuals);
     Eigen::Matrix<double, 3, kJet> df;
     for (int i = 0; i < 3; ++i) df.row(i) = x_dot[3 * part_ + i].v.transpose();
     df *= -inv_sigma_;
@@ -135,6 +135,39 @@ class ParametricCollocationCost : public BlockCost {
   }
 
  private:
+  // ((D X_b)_j − f) / σ, block b's rate at node j from its values at the nodes.
+  void WriteResidual(double const* const* parameters, const Eigen::Vector3d& f, double* residuals) const {
+    Eigen::Vector3d r = -f;
+    for (int k = 0; k <= degree_; ++k) r += scale_ * d_[k] * Eigen::Map<const Eigen::Vector3d>(parameters[k]);
+    Eigen::Map<Eigen::Vector3d>{residuals} = inv_sigma_ * r;
+  }
+
+  // The residual alone (a step's cost), in doubles: the same blocks as Evaluate reads.
+  bool Defect(double const* const* parameters, double* residuals) const {
+    const int N = degree_;
+    double x[9], x_dot[9];
+    for (int i = 0; i < 3; ++i) x[3 * part_ + i] = parameters[j_][i];
+    int next = N + 1;
+    for (int b = 0; b < 3; ++b) {
+      if (b == part_) continue;
+      for (int i = 0; i < 3; ++i) x[3 * b + i] = parameters[next][i];
+      ++next;
+    }
+    const Eigen::Matrix3d R = QuaternionMatrix(parameters[next++]);
+    const int controls = next;
+    Eigen::Vector4d rate = Eigen::Vector4d::Zero();
+    if (all_controls_) {
+      for (int k = 0; k <= N; ++k) rate += scale_ * d_[k] * Eigen::Map<const Eigen::Vector4d>(parameters[controls + k]);
+    }
+    const double* u = parameters[controls + (all_controls_ ? j_ : 0)];
+    next += all_controls_ ? N + 1 : 1;
+    const double* theta = theta_.data();
+    if constexpr (kIdentify) theta = parameters[next];
+    RotorDynamics(nominal_, x, R, u, rate.data(), theta, x_dot);
+    WriteResidual(parameters, Eigen::Map<const Eigen::Vector3d>(x_dot + 3 * part_), residuals);
+    return true;
+  }
+
   RotorNominal nominal_;
   int degree_;
   double scale_;
