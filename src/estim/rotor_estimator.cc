@@ -153,14 +153,22 @@ std::unique_ptr<Problem> BuildProblem(const RotorFlight& flight, size_t first, s
     problem->SetNode(n, x, R, rotor);
   }
   problem->SetChartReferences();
+  // One residual block per sensor and segment (AddMeasurements), a Huber loss per sample.
+  std::vector<double> times, position_times;
+  std::vector<AttitudeMeasurement> attitudes;
+  std::vector<VectorMeasurement> rates, positions;
   for (size_t i = first; i <= last; ++i) {
-    problem->AddMeasurement(s[i].t, AttitudeMeasurement{s[i].q.toRotationMatrix().transpose(), 1.0 / o.attitude_sigma_rad},
-                            3, 3, {}, loss);
-    problem->AddMeasurement(s[i].t, VectorMeasurement{s[i].w, 6, 1.0 / o.rate_sigma_radps}, 3, 3, {2}, loss, false);
+    times.push_back(s[i].t);
+    attitudes.push_back({s[i].q.toRotationMatrix().transpose(), 1.0 / o.attitude_sigma_rad});
+    rates.push_back({s[i].w, 6, 1.0 / o.rate_sigma_radps});
     if (s[i].fresh_position) {
-      problem->AddMeasurement(s[i].t, VectorMeasurement{s[i].p, 0, 1.0 / o.position_sigma_m}, 3, 3, {0}, loss, false);
+      position_times.push_back(s[i].t);
+      positions.push_back({s[i].p, 0, 1.0 / o.position_sigma_m});
     }
   }
+  problem->AddMeasurements(times, std::move(attitudes), 3, 3, {}, loss);
+  problem->AddMeasurements(times, std::move(rates), 3, 3, {2}, loss, false);
+  problem->AddMeasurements(position_times, std::move(positions), 3, 3, {0}, loss, false);
   return problem;
 }
 

@@ -323,6 +323,38 @@ TEST(PseudoSpectralProblem, MeasurementWithoutRotationKeepsNormalEquations) {
   ExpectGradientMatchesDifferences(without);
 }
 
+// Measurements added as batches (one block per segment) have the cost, gradient and Gauss–Newton
+// matrix of the same measurements added one by one, with a loss per sample, with and without the
+// rotation, and with more or fewer rows than the nodes' tangent.
+TEST(PseudoSpectralProblem, MeasurementBatchKeepsNormalEquations) {
+  ceres::HuberLoss loss(0.3);
+  for (int samples : {3, 17}) {
+    for (bool uses_rotation : {true, false}) {
+      auto one_by_one = AttitudeProblem(6, false);
+      auto batched = AttitudeProblem(6, false);
+      std::vector<double> times;
+      std::vector<PointObservation> observations;
+      for (int i = 0; i < samples; ++i) {
+        const double t = 0.05 + 1.9 * i / samples;
+        const PointObservation obs{{{1.0 + i, 2, 3 - 0.1 * i}}, i % 3};
+        times.push_back(t);
+        observations.push_back(obs);
+        one_by_one.AddMeasurement(t, obs, 3, 3, {0}, &loss, uses_rotation);
+      }
+      batched.AddMeasurements(times, observations, 3, 3, {0}, &loss, uses_rotation);
+      std::vector<ceres::ResidualBlockId> a_ids, b_ids;
+      one_by_one.ceres_problem().GetResidualBlocks(&a_ids);
+      batched.ceres_problem().GetResidualBlocks(&b_ids);
+      EXPECT_EQ(a_ids.size() - b_ids.size(), static_cast<size_t>(samples - 2));  // one block per segment
+      const Normal a = NormalEquations(one_by_one), b = NormalEquations(batched);
+      EXPECT_NEAR(a.cost, b.cost, 1e-10 * a.cost) << samples << uses_rotation;
+      EXPECT_LT((a.gradient - b.gradient).cwiseAbs().maxCoeff(), 1e-10 * a.gradient.cwiseAbs().maxCoeff());
+      EXPECT_LT((a.JtJ - b.JtJ).cwiseAbs().maxCoeff(), 1e-10 * a.JtJ.cwiseAbs().maxCoeff());
+      ExpectGradientMatchesDifferences(batched);
+    }
+  }
+}
+
 // A measurement evaluated alone (Ceres pricing a step: doubles) costs what it costs linearised
 // (ceres::Jet): compressed and not, with and without a loss, with and without the rotation.
 TEST(PseudoSpectralProblem, MeasurementCostsTheSameWithAndWithoutJacobians) {
@@ -332,13 +364,14 @@ TEST(PseudoSpectralProblem, MeasurementCostsTheSameWithAndWithoutJacobians) {
   problem.AddMeasurement(0.37, obs, 12, 3, {0}, &loss);                      // compressed
   problem.AddMeasurement(1.61, PointObservation{{obs.points[1]}, 1}, 3, 3, {0}, &loss);  // not
   problem.AddMeasurement(0.9, VectorObservation{}, 3, 3, {0}, nullptr, false);  // no rotation
+  problem.AddMeasurements({0.2, 0.3, 1.2}, std::vector<PointObservation>(3, obs), 12, 3, {0}, &loss);  // batches
   // Nodes off the trajectory, so that every residual is far from zero.
   for (int g = 0; g < problem.num_nodes(); ++g) {
     const StateSample x = problem.Interpolate(problem.NodeTime(g));
     problem.SetNode(g, x.vector * 1.3 + Eigen::Vector3d(0.1, -0.2, 0.05),
                     x.rotation * lie::SO3d::Exp(Eigen::Vector3d(0.02 * g, -0.1, 0.3)).Matrix(), x.control);
   }
-  EXPECT_EQ(cheval::testing::ExpectResidualOnlyEvaluationMatches(problem.ceres_problem()), 3 + 2 * 7 * 2);
+  EXPECT_EQ(cheval::testing::ExpectResidualOnlyEvaluationMatches(problem.ceres_problem()), 3 + 2 + 2 * 7 * 2);
 }
 
 TEST(PseudoSpectralProblem, OutsideIntervalIsAnError) {

@@ -236,14 +236,33 @@ class PseudoSpectralProblem {
                       const ceres::LossFunction* loss = nullptr, bool uses_rotation = true) {
     internal::TimeRow row = RowAt(t);
     const int s = row.segment;
-    auto cost = std::make_unique<internal::MeasurementCost<Model, F>>(SegmentOf(s), std::move(row), std::move(functor),
-                                                                      rows, group_rows, used_blocks, loss, uses_rotation);
-    ceres::LossFunction* ceres_loss = cost->ceres_loss();
-    Add(std::move(cost), ceres_loss);
-    if constexpr (kRotation) {
-      if (uses_rotation) {
-        for (int k = 0; k <= degree_; ++k) UseManifold(NodeOf(s, k));
-      }
+    AddMeasurementCost(s, std::make_unique<internal::MeasurementCost<Model, F>>(
+                              SegmentOf(s), std::move(row), std::move(functor), rows, group_rows, used_blocks, loss,
+                              uses_rotation),
+                       uses_rotation);
+  }
+
+  /// Adds the measurements h_i(x(t_i)) (`functors[i]` at `times[i]`, as AddMeasurement's, `rows` each)
+  /// as one residual block per segment (a batch of internal/measurement_cost.h, compressed): the same
+  /// cost, gradient and Gauss–Newton matrix as adding them one by one, with the loss per group of each,
+  /// in far fewer and smaller blocks (one per sensor and segment instead of one per sample). Throws
+  /// UsageError when the sizes differ, ComputeError when a time is outside the interval.
+  template <class F>
+  void AddMeasurements(const std::vector<double>& times, std::vector<F> functors, int rows, int group_rows,
+                       const std::vector<int>& used_blocks, const ceres::LossFunction* loss = nullptr,
+                       bool uses_rotation = true) {
+    using Cost = internal::MeasurementCost<Model, F>;
+    if (times.size() != functors.size()) throw UsageError("AddMeasurements: one functor per time");
+    std::map<int, std::vector<typename Cost::Sample>> by_segment;
+    for (size_t i = 0; i < times.size(); ++i) {
+      internal::TimeRow row = RowAt(times[i]);
+      const int s = row.segment;
+      by_segment[s].push_back({std::move(row), std::move(functors[i])});
+    }
+    for (auto& [s, samples] : by_segment) {
+      AddMeasurementCost(s, std::make_unique<Cost>(SegmentOf(s), std::move(samples), rows, group_rows, used_blocks,
+                                                   loss, uses_rotation),
+                         uses_rotation);
     }
   }
 
@@ -411,6 +430,18 @@ class PseudoSpectralProblem {
   PriorId Add(std::unique_ptr<internal::BlockCost> cost, ceres::LossFunction* loss = nullptr) {
     const std::vector<double*> blocks = cost->blocks();
     return problem_->AddResidualBlock(cost.release(), loss, blocks);
+  }
+
+  // A measurement's cost on segment s; its rotations (when it uses them) get the quaternion manifold.
+  template <class Cost>
+  void AddMeasurementCost(int s, std::unique_ptr<Cost> cost, bool uses_rotation) {
+    ceres::LossFunction* ceres_loss = cost->ceres_loss();
+    Add(std::move(cost), ceres_loss);
+    if constexpr (kRotation) {
+      if (uses_rotation) {
+        for (int k = 0; k <= degree_; ++k) UseManifold(NodeOf(s, k));
+      }
+    }
   }
 
   SmoothnessPrior& Smoothness(int order) {
