@@ -337,8 +337,9 @@ RotorIdentification IdentifyPiece(const RotorFlight& flight, size_t first, size_
   for (int a = 0; a < kFree; ++a) {
     for (int b = 0; b < kFree; ++b) id.covariance(ambient(a), ambient(b)) = tangent(a, b);
   }
-  id.reduced_chi2 =
-      2.0 * summary.final_cost / std::max(1, summary.num_residuals_reduced - summary.num_effective_parameters_reduced);
+  // Degrees of freedom: every measurement's rows (the compressed blocks return fewer) less θ and the states.
+  id.reduced_chi2 = 2.0 * summary.final_cost /
+                    std::max(1, problem->num_represented_rows() - summary.num_effective_parameters_reduced);
   id.covariance *= std::max(1.0, id.reduced_chi2);
   id.theta = theta;
   id.pieces = 1;

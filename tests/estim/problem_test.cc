@@ -346,6 +346,9 @@ TEST(PseudoSpectralProblem, MeasurementBatchKeepsNormalEquations) {
       one_by_one.ceres_problem().GetResidualBlocks(&a_ids);
       batched.ceres_problem().GetResidualBlocks(&b_ids);
       EXPECT_EQ(a_ids.size() - b_ids.size(), static_cast<size_t>(samples - 2));  // one block per segment
+      // The degrees of freedom still count every measurement's rows (a reduced χ² divides by them).
+      EXPECT_EQ(batched.num_represented_rows(), one_by_one.ceres_problem().NumResiduals());
+      EXPECT_EQ(one_by_one.num_represented_rows(), one_by_one.ceres_problem().NumResiduals());
       const Normal a = NormalEquations(one_by_one), b = NormalEquations(batched);
       EXPECT_NEAR(a.cost, b.cost, 1e-10 * a.cost) << samples << uses_rotation;
       EXPECT_LT((a.gradient - b.gradient).cwiseAbs().maxCoeff(), 1e-10 * a.gradient.cwiseAbs().maxCoeff());

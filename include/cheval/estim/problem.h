@@ -115,6 +115,19 @@ class PseudoSpectralProblem {
   double end_time() const { return breakpoints_.back(); }
   /// Segment boundaries t_0 < ... < t_S.
   const std::vector<double>& breakpoints() const { return breakpoints_; }
+  /// The residual rows of the problem as if no measurement were compressed (BlockCost::represented_rows):
+  /// the count a reduced χ² divides by, which Ceres' own count of (compressed) residuals is not.
+  int num_represented_rows() const {
+    std::vector<ceres::ResidualBlockId> ids;
+    problem_->GetResidualBlocks(&ids);
+    int rows = 0;
+    for (ceres::ResidualBlockId id : ids) {
+      const ceres::CostFunction* cost = problem_->GetCostFunctionForResidualBlock(id);
+      const auto* block = dynamic_cast<const internal::BlockCost*>(cost);
+      rows += block != nullptr ? block->represented_rows() : cost->num_residuals();
+    }
+    return rows;
+  }
   /// The underlying Ceres problem, to evaluate it (cost, Jacobian, covariance). Residuals are added
   /// through the Add* functions of this class only.
   ceres::Problem& ceres_problem() { return *problem_; }

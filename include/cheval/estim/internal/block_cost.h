@@ -15,6 +15,9 @@ namespace cheval::estim::internal {
 class BlockCost : public ceres::CostFunction {
  public:
   const std::vector<double*>& blocks() const { return blocks_; }
+  /// The residual rows this cost stands for: its own, or more for one that compresses its rows
+  /// (measurement_cost.h) — what a count of degrees of freedom (a reduced χ²) must use.
+  virtual int represented_rows() const { return num_residuals(); }
 
  protected:
   /// Appends a parameter block of `size` numbers.

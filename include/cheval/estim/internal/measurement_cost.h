@@ -94,6 +94,8 @@ class MeasurementCost : public BlockCost {
     }
   }
   int segment() const { return samples_.front().row.segment; }
+  /// Every measurement's rows, compressed or not.
+  int represented_rows() const override { return rows_ * static_cast<int>(samples_.size()); }
   /// The loss Ceres applies: only when the rows are not compressed (then the loss is per block).
   ceres::LossFunction* ceres_loss() const { return compress_ ? nullptr : const_cast<ceres::LossFunction*>(loss_); }
 
