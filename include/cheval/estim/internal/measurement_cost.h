@@ -28,12 +28,11 @@
 #include <vector>
 
 #include <ceres/jet.h>
-#include <ceres/loss_function.h>
 #include <Eigen/Core>
-#include <Eigen/QR>
 
 #include "cheval/common/error.h"
 #include "cheval/estim/internal/block_cost.h"
+#include "cheval/estim/internal/compressed_rows.h"
 #include "cheval/estim/internal/segment.h"
 #include "cheval/estim/manifold.h"
 #include "cheval/lie/so3.h"
@@ -128,13 +127,7 @@ class MeasurementCost : public BlockCost {
         if (rotation_) R_t = reference_ * lie::SO3d::Exp(phi).Matrix();
         if (!compress_) return sample.functor(x.data(), R_t, residuals);
         if (!sample.functor(x.data(), R_t, h.data())) return false;
-        for (int gi = 0; gi < rows_ / group_rows_; ++gi) {
-          double sq = 0.0;
-          for (int e = 0; e < group_rows_; ++e) sq += h[gi * group_rows_ + e] * h[gi * group_rows_ + e];
-          double rho[3] = {sq, 1.0, 0.0};
-          if (loss_ != nullptr) loss_->Evaluate(sq, rho);
-          cost += rho[0];
-        }
+        cost += GroupedCost(h.data(), rows_, group_rows_, loss_);
       }
       std::fill_n(residuals, num_residuals(), 0.0);
       residuals[0] = std::sqrt(cost);
@@ -170,7 +163,7 @@ class MeasurementCost : public BlockCost {
       out_r = r;
       out_J = J;
     } else {
-      Compress(&r, &J, &out_r, &out_J);
+      CompressRows(group_rows_, loss_, &r, &J, &out_r, &out_J);
     }
     Eigen::Map<Eigen::VectorXd>(residuals, out_r.size()) = out_r;
     const int m = static_cast<int>(out_r.size());
@@ -241,35 +234,6 @@ class MeasurementCost : public BlockCost {
       }
     }
     return true;
-  }
-
-  // The rows weighted by the loss (IRLS, √ρ' per group) and reduced by QR to the rank of J's columns,
-  // with a last row carrying the rest of Σρ (see the contract).
-  void Compress(Eigen::VectorXd* r, Eigen::MatrixXd* J, Eigen::VectorXd* out_r, Eigen::MatrixXd* out_J) const {
-    double cost = 0.0;  // Σ ρ(s_i) (or s_i without a loss) over the groups
-    for (Eigen::Index first = 0; first < r->size(); first += group_rows_) {
-      auto rg = r->segment(first, group_rows_);
-      const double s = rg.squaredNorm();
-      if (loss_ == nullptr) {
-        cost += s;
-        continue;
-      }
-      double rho[3];
-      loss_->Evaluate(s, rho);
-      cost += rho[0];
-      const double root = std::sqrt(std::max(rho[1], 0.0));
-      rg *= root;
-      J->middleRows(first, group_rows_) *= root;
-    }
-    // J = Q [T; 0]: cost and gradient kept by [Q1ᵀ r; sqrt(cost − |Q1ᵀ r|²)] with Jacobian [T; 0].
-    const Eigen::Index rank = std::min(J->rows(), J->cols());
-    Eigen::HouseholderQR<Eigen::MatrixXd> qr(*J);
-    const Eigen::VectorXd qtr = qr.householderQ().adjoint() * (*r);
-    out_r->resize(rank + 1);
-    out_r->head(rank) = qtr.head(rank);
-    (*out_r)[rank] = std::sqrt(std::max(0.0, cost - out_r->head(rank).squaredNorm()));
-    *out_J = Eigen::MatrixXd::Zero(rank + 1, J->cols());
-    out_J->topRows(rank) = qr.matrixQR().topRows(rank).template triangularView<Eigen::Upper>();
   }
 
   std::vector<double*> storage_;  // every node's vector part (point order): the blocks h does not use
