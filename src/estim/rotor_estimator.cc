@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <memory>
 
 #include <ceres/covariance.h>
@@ -15,6 +16,7 @@
 #include "cheval/cheb/chebyshev.h"
 #include "cheval/common/error.h"
 #include "cheval/common/options.h"
+#include "cheval/estim/internal/delayed_position_cost.h"
 #include "cheval/estim/internal/parametric_collocation_cost.h"
 #include "cheval/estim/problem.h"
 #include "rotor_internal.h"
@@ -126,9 +128,11 @@ std::vector<std::pair<size_t, size_t>> Spans(const RotorFlight& flight, double m
 }
 
 // The problem over samples [first, last], initial values set, measurements added (no dynamics yet).
+// With `clock_offset` (a parameter block, seconds), the positions are stamped δ behind the problem's
+// (the onboard samples') time (DelayedPositionCost); without it they share it.
 std::unique_ptr<Problem> BuildProblem(const RotorFlight& flight, size_t first, size_t last, const RotorModel& model,
                                       const RotorEstimateOptions& o, bool measured_rotors,
-                                      const ceres::LossFunction* loss) {
+                                      const ceres::LossFunction* loss, double* clock_offset = nullptr) {
   const std::vector<RotorSample>& s = flight.samples;
   const double t0 = s[first].t, t1 = s[last].t;
   const int segments = SegmentCount("RotorEstimateOptions", t1 - t0, o.segment_s, o.degree);
@@ -168,7 +172,23 @@ std::unique_ptr<Problem> BuildProblem(const RotorFlight& flight, size_t first, s
   }
   problem->AddMeasurements(times, std::move(attitudes), 3, 3, {}, loss);
   problem->AddMeasurements(times, std::move(rates), 3, 3, {2}, loss, false);
-  problem->AddMeasurements(position_times, std::move(positions), 3, 3, {0}, loss, false);
+  if (clock_offset == nullptr) {
+    problem->AddMeasurements(position_times, std::move(positions), 3, 3, {0}, loss, false);
+    return problem;
+  }
+  std::map<int, std::vector<internal::DelayedPositionCost::Sample>> by_segment;
+  for (size_t i = 0; i < position_times.size(); ++i) {
+    internal::TimeRow row = problem->RowAt(position_times[i]);
+    const int segment = row.segment;
+    by_segment[segment].push_back({std::move(row), positions[i].measured});
+  }
+  for (auto& [segment, samples] : by_segment) {
+    problem->AddPrior(std::make_unique<internal::DelayedPositionCost>(problem->SegmentOf(segment), std::move(samples), 0,
+                                                                      1, o.position_sigma_m, loss, clock_offset));
+  }
+  ceres::Problem& cp = problem->ceres_problem();
+  cp.SetParameterLowerBound(clock_offset, 0, -kMaxClockOffsetS);
+  cp.SetParameterUpperBound(clock_offset, 0, kMaxClockOffsetS);
   return problem;
 }
 
@@ -246,7 +266,9 @@ RotorEstimate EstimateRotors(const RotorFlight& flight, const RotorVehicle& vehi
   const auto start = Clock::now();
   out.converged = true;
   for (const auto& [first, last] : spans) {
-    std::unique_ptr<Problem> problem = BuildProblem(flight, first, last, model, o, false, &huber);
+    double clock_offset = 0;
+    std::unique_ptr<Problem> problem =
+        BuildProblem(flight, first, last, model, o, false, &huber, o.estimate_clock_offset ? &clock_offset : nullptr);
     RotorThetaVector theta = vehicle.theta;
     AddDynamics<false>(*problem, model, o, theta.data());
     problem->AddControlSmoothnessPrior(1, o.sigma_rotor_rate);
@@ -256,8 +278,11 @@ RotorEstimate EstimateRotors(const RotorFlight& flight, const RotorVehicle& vehi
     out.states += problem->num_nodes();
     out.segments += problem->num_segments();
     out.duration_s += flight.samples[last].t - flight.samples[first].t;
+    out.clock_offsets_s.push_back(clock_offset);
     for (size_t i = first; i <= last; ++i) {
-      const StateSample x = problem->Interpolate(flight.samples[i].t);
+      // The flight's stamps are the motion capture's (and the rotor telemetry's): the problem's time is δ later.
+      const StateSample x = problem->Interpolate(
+          std::clamp(flight.samples[i].t + clock_offset, problem->start_time(), problem->end_time()));
       estimate[i] = x.control.head<4>();
       RotorStateEstimate e;
       e.t = flight.samples[i].t;
@@ -303,19 +328,30 @@ RotorIdentification IdentifyPiece(const RotorFlight& flight, size_t first, size_
   // J_z is held: every yaw torque (k_M Ω², the rotors' reaction, τ0_z) is seen only through its ratio
   // to J_z (docs/estimator_real_data.md).
   ceres::SubsetManifold hold_yaw_inertia(kRotorThetaSize, {kThetaInertiaX + 2});
-  std::unique_ptr<Problem> problem = BuildProblem(flight, first, last, model, o, true, &huber);
-  AddDynamics<true>(*problem, model, o, theta.data());
-  problem->AddPrior(std::make_unique<ThetaPrior>(theta.data(), RotorNominal::PublishedTheta(), PriorSigma()));
-  problem->ceres_problem().SetManifold(theta.data(), &hold_yaw_inertia);
-  for (int i = 0; i < 2; ++i) {  // a rigid body's inertia is positive: at least 1 % of the published one
-    problem->ceres_problem().SetParameterLowerBound(theta.data(), kThetaInertiaX + i, 0.01);
+  // The onboard clock's offset δ from the motion capture's, which the rotor telemetry shares
+  // (docs/estimator_real_data.md, "Two clocks"): free in the positions; the telemetry's rows sit at
+  // t + δ of the pass before (two passes, the second from the first's δ and θ).
+  double clock_offset = 0;
+  std::unique_ptr<Problem> problem;
+  ceres::Solver::Summary summary;
+  for (int pass = 0; pass < (o.estimate_clock_offset ? 2 : 1); ++pass) {
+    const double telemetry_offset = clock_offset;
+    problem = BuildProblem(flight, first, last, model, o, true, &huber, o.estimate_clock_offset ? &clock_offset : nullptr);
+    AddDynamics<true>(*problem, model, o, theta.data());
+    problem->AddPrior(std::make_unique<ThetaPrior>(theta.data(), RotorNominal::PublishedTheta(), PriorSigma()));
+    problem->ceres_problem().SetManifold(theta.data(), &hold_yaw_inertia);
+    for (int i = 0; i < 2; ++i) {  // a rigid body's inertia is positive: at least 1 % of the published one
+      problem->ceres_problem().SetParameterLowerBound(theta.data(), kThetaInertiaX + i, 0.01);
+    }
+    for (size_t i = first; i <= last; ++i) {
+      const internal::TimeRow row = problem->RowAt(
+          std::clamp(flight.samples[i].t + telemetry_offset, problem->start_time(), problem->end_time()));
+      problem->AddPrior(std::make_unique<RotorSpeedMeasurement>(problem->SegmentOf(row.segment), row.w,
+                                                                flight.samples[i].rotor, o.rotor_sigma_radps));
+    }
+    summary = problem->Solve(SolverOptions(o));
   }
-  for (size_t i = first; i <= last; ++i) {
-    const internal::TimeRow row = problem->RowAt(flight.samples[i].t);
-    problem->AddPrior(std::make_unique<RotorSpeedMeasurement>(problem->SegmentOf(row.segment), row.w,
-                                                              flight.samples[i].rotor, o.rotor_sigma_radps));
-  }
-  const ceres::Solver::Summary summary = problem->Solve(SolverOptions(o));
+  id.clock_offset_s = clock_offset;
   id.converged = summary.termination_type == ceres::CONVERGENCE;
   ceres::Covariance::Options copt;
   copt.num_threads = o.threads;
@@ -399,6 +435,7 @@ RotorIdentification CombineIdentifications(const std::vector<RotorIdentification
     information += lambda;
     eta += lambda * theta;
     out.reduced_chi2 = std::max(out.reduced_chi2, p.reduced_chi2);
+    out.clock_offset_s += p.clock_offset_s / static_cast<double>(pieces.size());
     out.seconds += p.seconds;
     out.pieces += p.pieces;
   }

@@ -28,7 +28,8 @@ std::string RotorEstimateJson(const RotorEstimate& e, const RotorFlight& flight)
                               {"converged", e.converged},
                               {"scored_samples", e.scored_samples},
                               {"dropped_rows", flight.dropped_lines},
-                              {"flying_spans", spans}};
+                              {"flying_spans", spans},
+                              {"clock_offsets_s", e.clock_offsets_s}};
   return out.dump(2) + "\n";
 }
 

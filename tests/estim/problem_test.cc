@@ -17,6 +17,7 @@
 #include "../support/residual_only.h"
 #include "cheval/cheb/chebyshev.h"
 #include "cheval/common/error.h"
+#include "cheval/estim/internal/delayed_position_cost.h"
 #include "cheval/estim/models.h"
 #include "cheval/estim/problem.h"
 #include "cheval/lie/so3.h"
@@ -375,6 +376,62 @@ TEST(PseudoSpectralProblem, MeasurementCostsTheSameWithAndWithoutJacobians) {
                     x.rotation * lie::SO3d::Exp(Eigen::Vector3d(0.02 * g, -0.1, 0.3)).Matrix(), x.control);
   }
   EXPECT_EQ(cheval::testing::ExpectResidualOnlyEvaluationMatches(problem.ceres_problem()), 3 + 2 + 2 * 7 * 2);
+}
+
+// A point mass for the delayed positions: vector state (p, v) in blocks of 3, control u = v'.
+struct PointMassModel {
+  static constexpr int kVectorDim = 6;
+  static constexpr int kBlockSize = 3;
+  static constexpr bool kHasRotation = false;
+  static constexpr int kControlDim = 3;
+  template <typename T>
+  void Dynamics(const T* x, const Eigen::Matrix<T, 3, 3>& /*R*/, const T* u, T* x_dot, T* /*omega*/) const {
+    for (int i = 0; i < 3; ++i) {
+      x_dot[i] = x[3 + i];
+      x_dot[3 + i] = u[i];
+    }
+  }
+};
+Eigen::Vector3d MassPosition(double t) { return {std::sin(t), t * t, std::cos(2 * t)}; }
+Eigen::Vector3d MassVelocity(double t) { return {std::cos(t), 2 * t, -2 * std::sin(2 * t)}; }
+
+// Positions stamped by a clock δ behind the problem's: with the problem's nodes on the trajectory, the
+// cost vanishes at the true δ (to the expansion's error δ³|p⁽³⁾|/6) and not at δ = 0; its gradient (δ
+// included) matches central differences, and a step is priced as the linearisation says.
+TEST(PseudoSpectralProblem, DelayedPositionsMeetTheTrajectoryAtTheirClockOffset) {
+  const double true_offset = 0.03, sigma = 1e-3;
+  PseudoSpectralProblem<PointMassModel> problem(PointMassModel{}, {0.0, 1.0, 2.0}, 10);
+  for (int g = 0; g < problem.num_nodes(); ++g) {
+    const double t = problem.NodeTime(g);
+    Eigen::VectorXd x(6);
+    x << MassPosition(t), MassVelocity(t);
+    problem.SetNode(g, x, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+  }
+  double offset = 0;
+  ceres::HuberLoss loss(3.0);
+  for (int s = 0; s < 2; ++s) {
+    std::vector<internal::DelayedPositionCost::Sample> samples;
+    for (int i = 0; i < 20; ++i) {
+      const double t = s + 0.013 + 0.049 * i;
+      samples.push_back({problem.RowAt(t), MassPosition(t + true_offset)});
+    }
+    problem.AddPrior(std::make_unique<internal::DelayedPositionCost>(problem.SegmentOf(s), std::move(samples), 0, 1,
+                                                                     sigma, &loss, &offset));
+  }
+  const auto cost = [&] {
+    double c = 0;
+    problem.ceres_problem().Evaluate(ceres::Problem::EvaluateOptions(), &c, nullptr, nullptr, nullptr);
+    return c;
+  };
+  const double at_zero = cost();
+  offset = true_offset;
+  const double at_truth = cost();
+  EXPECT_GT(at_zero, 1e3);              // 3 cm of motion against σ = 1 mm
+  EXPECT_LT(at_truth, 1e-4 * at_zero);  // the expansion's error is a few µm
+  offset = 0.02;
+  ExpectGradientMatchesDifferences(problem);
+  EXPECT_EQ(cheval::testing::ExpectResidualOnlyEvaluationMatches(problem.ceres_problem()), 2);
+  EXPECT_EQ(problem.num_represented_rows(), 3 * 40);
 }
 
 TEST(PseudoSpectralProblem, OutsideIntervalIsAnError) {

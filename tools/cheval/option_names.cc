@@ -95,6 +95,7 @@ constexpr std::array kFlags = std::to_array<OptionName>({
     {"RotorEstimateOptions::identification_piece_s", "--piece"},
     {"RotorEstimateOptions::max_iterations", "--max-iterations"},
     {"RotorEstimateOptions::threads", "--threads"},
+    {"RotorEstimateOptions::estimate_clock_offset", "--no-clock-offset"},
 });
 
 // evo's spellings (evo_ape / evo_rpe / evo_traj 1.36.5 argparse names), one table for the CLI's

@@ -37,6 +37,9 @@ void AddModelOptions(CLI::App* command, estim::RotorEstimateOptions& o) {
                       "Collocation sigma of the body rate's derivative (rad/s^2)")
       ->capture_default_str();
   command->add_option("--threads", o.threads, "Solver threads (default: the machine's cores)")->capture_default_str();
+  command->add_flag("!--no-clock-offset", o.estimate_clock_offset,
+                    "Take the onboard samples and the motion capture as stamped by one clock (default: estimate "
+                    "their offset)");
   command->add_option("--max-iterations", o.max_iterations, "Levenberg-Marquardt iterations at most")
       ->capture_default_str();
   command->add_option("--baseline-window", o.baseline_window_s, "Window of the flatness baseline's fits (s)")
@@ -85,6 +88,11 @@ void RegisterEstimateRotors(CLI::App& app, Action* action) {
       fmt::print("duration            {:.2f} s ({} scored samples)\n", e.duration_s, e.scored_samples);
       fmt::print("states              {}\nsegments            {}\nsolver iterations   {}{}\nseconds             {:.3f}\n",
                  e.states, e.segments, e.iterations, e.converged ? "" : "  (did not converge)", e.seconds);
+      if (flags->options.estimate_clock_offset) {
+        std::string offsets;
+        for (double d : e.clock_offsets_s) offsets += fmt::format("{}{:.1f}", offsets.empty() ? "" : " ", 1e3 * d);
+        fmt::print("clock offset ms     {}  (onboard minus motion capture, per span)\n", offsets);
+      }
       fmt::print("rotor error rpm     {}\n", Row(e.error.rpm, "{:.1f} {:.1f} {:.1f} {:.1f}"));
       fmt::print("rotor error %       {}\n", Row(e.error.percent, "{:.3f} {:.3f} {:.3f} {:.3f}"));
       fmt::print("flatness rpm        {}\n", Row(e.baseline.rpm, "{:.1f} {:.1f} {:.1f} {:.1f}"));
@@ -133,9 +141,9 @@ void RegisterIdentifyRotors(CLI::App& app, Action* action) {
       std::vector<estim::RotorIdentification> per_flight;
       const estim::RotorVehicle out = estim::IdentifyRotors(flights, base, flags->options, &per_flight);
       for (size_t f = 0; f < flights.size(); ++f) {
-        fmt::print("{}: {} piece(s), {:.2f} s, reduced chi2 <= {:.3g}{}\n", flights[f].path, per_flight[f].pieces,
-                   per_flight[f].seconds, per_flight[f].reduced_chi2,
-                   per_flight[f].converged ? "" : "  (a piece did not converge)");
+        fmt::print("{}: {} piece(s), {:.2f} s, reduced chi2 <= {:.3g}, clock offset {:.1f} ms{}\n", flights[f].path,
+                   per_flight[f].pieces, per_flight[f].seconds, per_flight[f].reduced_chi2,
+                   1e3 * per_flight[f].clock_offset_s, per_flight[f].converged ? "" : "  (a piece did not converge)");
       }
       const char* names[] = {"k_m1/k_F", "k_m2/k_F", "k_m3/k_F", "k_m4/k_F", "Jx/Jx_pub", "Jy/Jy_pub",
                              "Jz/Jz_pub", "k_M/Kc", "tau0_x [1e-5 N m]", "tau0_y [1e-5 N m]",

@@ -56,6 +56,11 @@ struct RotorEstimateOptions {
   /// span is one piece), identified one by one; their spread enters θ's σ (IdentifyRotors).
   double identification_piece_s = 8.0;
   double score_margin_s = 0.5;     ///< scored samples: flying, this far from a span's ends (>= 0)
+  /// Estimation: estimate the offset δ between the onboard clock (attitude, body rates) and the motion
+  /// capture's (positions; the rotor telemetry shares it) with the trajectory, and give the rotor
+  /// speeds in the motion capture's time. On the shared flights the onboard samples arrive 0–30 ms
+  /// late, differently on each (docs/estimator_real_data.md, "Two clocks"). |δ| <= kMaxClockOffsetS.
+  bool estimate_clock_offset = true;
   /// Levenberg–Marquardt iterations (>= 1). On the shared flights the rotor speeds after 6 iterations
   /// differ from those after 30 by < 0.1 % of the speed (docs/estimator_real_data.md).
   int max_iterations = 8;
@@ -69,6 +74,9 @@ struct RotorEstimateOptions {
   /// Throws OptionError naming the first field out of its range.
   void Validate() const;
 };
+
+/// The largest clock offset EstimateRotors considers, s (its positions are expanded to second order in δ).
+inline constexpr double kMaxClockOffsetS = 0.1;
 
 /// Revolutions per minute in one rad/s: the rotor speeds are rad/s inside, rpm where people read them.
 inline constexpr double kRpmPerRadps = 30.0 / std::numbers::pi;
@@ -97,6 +105,9 @@ struct RotorEstimate {
   double seconds = 0;               ///< wall time of the estimate (not of the baseline)
   double duration_s = 0;            ///< the estimated span(s), s
   int states = 0, segments = 0, iterations = 0, scored_samples = 0;
+  /// Per flying span, the onboard clock minus the motion capture's (s): an instant the motion capture
+  /// stamps t is stamped t + δ onboard (0 when not estimated).
+  std::vector<double> clock_offsets_s;
   bool converged = false;
   std::vector<RotorStateEstimate> samples;  ///< at every sample inside a flying span
 };
@@ -127,6 +138,7 @@ struct RotorIdentification {
   /// Combined: each parameter's Birge ratio (>= 1), by which its σ was scaled.
   RotorThetaVector dispersion = RotorThetaVector::Ones();
   double reduced_chi2 = 0;  ///< combined: the largest of the pieces'
+  double clock_offset_s = 0;  ///< the onboard clock minus the motion capture's (combined: the pieces' mean)
   double seconds = 0;
   int pieces = 0;
   bool converged = false;
@@ -157,7 +169,7 @@ namespace cheval::estim {
 /// The `estimate rotors --json` object: `rotor_error_percent`, `flatness_error_percent` (4 each, m1..m4),
 /// `rotor_error_rpm`, `flatness_error_rpm`, `seconds`, `duration_s`, `states`, `segments`,
 /// `iterations`, `converged`, `scored_samples`, `dropped_rows` (file lines of rows with missing
-/// values) and `flying_spans` ([first, last] s each).
+/// values), `flying_spans` ([first, last] s each) and `clock_offsets_s` (one per span).
 std::string RotorEstimateJson(const RotorEstimate& estimate, const RotorFlight& flight);
 
 /// The `-o` CSV: `t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz` (estimated; world position and velocity,
