@@ -9,7 +9,7 @@
 // kinds: hand tremor on a handheld motion and velocity steps (impacts) on a noise-free legged one.
 // Ratios are against the baselines measured in the same run. A second table: body angular velocity
 // from noisy orientations.
-//   build/bench/velocity_accuracy [DATA_DIR [SEEDS [FIRST_SEED]]]
+//   build/bench/velocity_accuracy [DATA_DIR [SEEDS [FIRST_SEED [ROWS]]]]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -214,6 +214,10 @@ int main(int argc, char** argv) {
   const uint64_t seeds = argc > 2 ? std::stoull(argv[2]) : 1;
   // Optional: the first seed (default 1), to test on seeds the tables of docs/velocity.md do not use.
   const uint64_t first_seed = argc > 3 ? std::stoull(argv[3]) : 1;
+  // Optional: only the rows whose name contains this text (e.g. "tremor" or "legged, 2.0"); the
+  // angular table only without it.
+  const std::string only = argc > 4 ? argv[4] : "";
+  auto wanted = [&only](const std::string& name) { return name.find(only) != std::string::npos; };
   std::printf("velocity RMSE in mm/s, full range unless marked inner (middle 90 %%)\n\n");
   std::printf("| %-28s | %10s | %10s | %10s | %10s | %10s | %16s | %10s | %10s | %6s | %6s | %6s | %6s |\n",
               "trajectory", "cheval (cv)", "inner", "chop", "central", "median-5", "SG best (win)", "spline GCV",
@@ -234,13 +238,16 @@ int main(int argc, char** argv) {
         char name[64];
         std::snprintf(name, sizeof(name), "%s, %.1f mm%s", std::string(sim::ToString(kind)).c_str(), 1e3 * noise,
                       seeds > 1 || first_seed > 1 ? fmt::format(", seed {}", seed).c_str() : "");
-        Print(Evaluate(name, measured.View(), truth.View().velocities()));
+        if (wanted(name)) Print(Evaluate(name, measured.View(), truth.View().velocities()));
       }
     }
   }
-  for (const Case& c : {Tremor(0.0005), Tremor(0.0), Impacts()}) Print(Evaluate(c.name, c.measured.View(), c.truth));
+  for (const Case& c : {Tremor(0.0005), Tremor(0.0), Impacts()}) {
+    if (wanted(c.name)) Print(Evaluate(c.name, c.measured.View(), c.truth));
+  }
   for (const char* file : {"MH_05_difficult.csv", "V1_01_easy.csv", "V1_02_medium.csv", "V2_02_medium.csv"}) {
     const std::string path = data + "/ov_data/euroc_mav/" + file;
+    if (!wanted(std::string("EuRoC ") + file)) continue;
     if (!std::filesystem::exists(path)) {
       std::printf("(missing %s)\n", path.c_str());
       continue;
@@ -248,6 +255,6 @@ int main(int argc, char** argv) {
     const traj::Trajectory gt = traj::ReadTrajectory(path);
     Print(Evaluate(std::string("EuRoC ") + file, gt.View(), gt.View().velocities()));
   }
-  AngularTable();
+  if (only.empty()) AngularTable();
   return 0;
 }

@@ -38,6 +38,10 @@ constexpr double kNoiseMargin = 1.1;
 // (SplitPredictsBetter). At 1 the charts of rotations, whose noise varies along them, were split
 // where that did not help (docs/decisions.md).
 constexpr double kSplitScore = 2.0;
+// Held-out squared errors come from sums (Σz² − 2cᵀb + cᵀGc of samples centred on their mean):
+// below this fraction of Σ(z − z̄)² they are rounding (nearly exact data), and comparing a window
+// with its halves by them says nothing.
+constexpr double kHeldOutFloor = 1e-12;
 // End windows are halved (RefineEnds) while they keep this many samples on each side.
 constexpr Eigen::Index kMinEndWindowSamples = 24;
 using internal::kMaxGramCondition;
@@ -52,9 +56,12 @@ class WindowFitter {
   // Fits the window of core [a, b] inside segment [segment_begin, segment_end]. Returns nullopt
   // when the series is not resolved and splitting is allowed.
   // With `held_out`, a cross-validated window also gives its held-out squared error per sample and
-  // coordinate at its cross-validated degrees (empty for the other methods).
+  // coordinate at its cross-validated degrees (empty for the other methods). With `undecided`, a
+  // window that may be split but whose coefficients cannot show it resolved while its residual is
+  // consistent with the noise is returned (verdict resolved) with *undecided set: the caller
+  // decides by prediction whether to split it (SplitPredictsBetter).
   std::optional<CurveWindow> Fit(double a, double b, double segment_begin, double segment_end, bool may_split,
-                                 Eigen::VectorXd* held_out = nullptr) const {
+                                 Eigen::VectorXd* held_out = nullptr, bool* undecided = nullptr) const {
     const double extension = options_.overlap * (b - a);
     CurveWindow window;
     window.core_begin = a;
@@ -147,12 +154,23 @@ class WindowFitter {
     // of the coefficients is statistically pure noise, the window is resolved anyway.
     if (!resolved) resolved = TailIsNoise(high, *cholesky);
     if (held_out != nullptr) held_out->resize(0);
-    if (cross_validate && (resolved || !may_split)) {
+    // No plateau and a tail above the noise say that the window *may* miss motion above its top
+    // degree, not that it does: at 2 mm of noise a 190-sample window of a legged gait has such a
+    // tail, and so do all its halves down to the smallest, whose cross-validated degrees (2–3) then
+    // miss more than the whole did. When the residual is consistent with the noise, prediction
+    // decides instead (the caller's SplitPredictsBetter), unless the held-out errors are rounding.
+    bool arbitrate = !resolved && may_split && undecided != nullptr && cross_validate && options_.lack_of_fit;
+    if (cross_validate && (resolved || !may_split || arbitrate)) {
       Eigen::VectorXd error;
       window.degrees = CrossValidatedDegrees(*folds, top, &error);
       if (held_out != nullptr) *held_out = error / static_cast<double>(m);
+      if (arbitrate) {
+        Eigen::RowVectorXd spread = Eigen::RowVectorXd::Zero(d);
+        for (const Eigen::RowVectorXd& squares : folds->squares) spread += squares;
+        for (int c = 0; c < d; ++c) arbitrate = arbitrate && error[c] > kHeldOutFloor * spread[c];
+      }
     }
-    if (!resolved && may_split) return std::nullopt;
+    if (!resolved && !arbitrate && may_split) return std::nullopt;
 
     // The residual must be consistent with the noise too: a series can look resolved while the
     // motion it misses lies above the top degree the window may use. A coordinate whose residual
@@ -181,7 +199,8 @@ class WindowFitter {
       }
     }
     if (!consistent && may_split) return std::nullopt;
-    window.verdict = resolved && consistent ? WindowVerdict::kResolved : WindowVerdict::kUnresolved;
+    if (arbitrate) *undecided = true;
+    window.verdict = (resolved || arbitrate) && consistent ? WindowVerdict::kResolved : WindowVerdict::kUnresolved;
     Finish(&window);
     return window;
   }
@@ -454,16 +473,17 @@ class WindowFitter {
 };
 
 // A window accepted while its residual is above the noise (lack-of-fit score above kSplitScore in
-// some coordinate) may still miss motion above its top degree that the test cannot prove at its
-// length. Its two halves are fitted too, and it is split when they predict held-out samples better:
-// their cross-validated squared error per sample, relative to the window's own and averaged over
-// the coordinates, is below 1 (no σ is involved).
+// some coordinate), or `undecided` (its coefficients could not show it resolved, WindowFitter::Fit),
+// may still miss motion above its top degree that the residual test cannot prove at its length.
+// Its two halves are fitted too, and it is split when they predict held-out samples better: their
+// cross-validated squared error per sample, relative to the window's own and averaged over the
+// coordinates, is below 1 (no σ is involved).
 bool SplitPredictsBetter(const WindowFitter& fitter, const CurveWindow& window, const Eigen::VectorXd& held_out,
-                         const CurveSegment& segment, const CurveOptions& options) {
+                         const CurveSegment& segment, const CurveOptions& options, bool undecided) {
   if (options.degree_method != DegreeMethod::kCrossValidation || !options.lack_of_fit || held_out.size() == 0) {
     return false;
   }
-  if (!(window.lack_of_fit.maxCoeff() > kSplitScore) || !(held_out.minCoeff() > 0.0)) return false;
+  if (!(undecided || window.lack_of_fit.maxCoeff() > kSplitScore) || !(held_out.minCoeff() > 0.0)) return false;
   const double middle = 0.5 * (window.core_begin + window.core_end);
   Eigen::VectorXd left_error, right_error;
   const CurveWindow left = *fitter.Fit(window.core_begin, middle, segment.begin, segment.end, false, &left_error);
@@ -486,8 +506,11 @@ std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::Ve
         std::upper_bound(t.data(), t.data() + t.size(), b) - std::lower_bound(t.data(), t.data() + t.size(), a);
     const bool may_split = inside >= 2 * options.min_window_samples;
     Eigen::VectorXd held_out;
-    std::optional<CurveWindow> window = fitter.Fit(a, b, segment.begin, segment.end, may_split, &held_out);
-    if (window && may_split && SplitPredictsBetter(fitter, *window, held_out, segment, options)) window.reset();
+    bool undecided = false;
+    std::optional<CurveWindow> window = fitter.Fit(a, b, segment.begin, segment.end, may_split, &held_out, &undecided);
+    if (window && may_split && SplitPredictsBetter(fitter, *window, held_out, segment, options, undecided)) {
+      window.reset();
+    }
     if (!window) {
       const double middle = 0.5 * (a + b);
       stack.emplace_back(middle, b);  // the left half is popped first: windows stay in time order

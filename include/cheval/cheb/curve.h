@@ -95,8 +95,10 @@ struct CurveOptions {
 
 /// Why a window was accepted.
 enum class WindowVerdict {
-  /// Its series reached the noise plateau (standardChop or a noise-like tail) and its residual is
-  /// consistent with the noise (the lack-of-fit test, docs/velocity.md).
+  /// Its series reached the noise plateau (standardChop or a noise-like tail), or its halves
+  /// predict held-out samples no better than it does (cross-validated fits, when the coefficients
+  /// cannot tell), and its residual is consistent with the noise (the lack-of-fit test,
+  /// docs/velocity.md).
   kResolved,
   /// It fails one of those tests but could not be split further (too few samples, or a literal
   /// fit: window_s, single_window, end windows): its velocity may miss motion there.
