@@ -55,24 +55,26 @@ struct VectorMeasurement {
   }
 };
 
-// (θ − θ0) / σ: the weak prior of the identification.
-class ThetaPrior : public internal::BlockCost {
+// (x − x0) / σ on a block of numbers: the weak priors of θ (identification) and the clock offset.
+class DiagonalPrior : public internal::BlockCost {
  public:
-  ThetaPrior(double* theta, const RotorThetaVector& mean, const RotorThetaVector& sigma) : mean_(mean), sigma_(sigma) {
-    AddBlock(theta, kRotorThetaSize);
-    set_num_residuals(kRotorThetaSize);
+  DiagonalPrior(double* block, Eigen::VectorXd mean, Eigen::VectorXd sigma)
+      : mean_(std::move(mean)), sigma_(std::move(sigma)) {
+    AddBlock(block, static_cast<int>(mean_.size()));
+    set_num_residuals(static_cast<int>(mean_.size()));
   }
   bool Evaluate(double const* const* p, double* r, double** J) const override {
-    for (int i = 0; i < kRotorThetaSize; ++i) r[i] = (p[0][i] - mean_[i]) / sigma_[i];
+    const Eigen::Index n = mean_.size();
+    Eigen::Map<Eigen::VectorXd>(r, n) = (Eigen::Map<const Eigen::VectorXd>(p[0], n) - mean_).cwiseQuotient(sigma_);
     if (J && J[0]) {
-      Eigen::Map<Eigen::Matrix<double, kRotorThetaSize, kRotorThetaSize, Eigen::RowMajor>> m{J[0]};
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> m{J[0], n, n};
       m = sigma_.cwiseInverse().asDiagonal();
     }
     return true;
   }
 
  private:
-  RotorThetaVector mean_, sigma_;
+  Eigen::VectorXd mean_, sigma_;
 };
 
 // (Ω(t) − Ω_measured) / σ with Ω(t) = Σ_k w_k(t) U_k: a measured rotor speed at any time.
@@ -186,9 +188,10 @@ std::unique_ptr<Problem> BuildProblem(const RotorFlight& flight, size_t first, s
     problem->AddPrior(std::make_unique<internal::DelayedPositionCost>(problem->SegmentOf(segment), std::move(samples), 0,
                                                                       1, o.position_sigma_m, loss, clock_offset));
   }
-  ceres::Problem& cp = problem->ceres_problem();
-  cp.SetParameterLowerBound(clock_offset, 0, -kMaxClockOffsetS);
-  cp.SetParameterUpperBound(clock_offset, 0, kMaxClockOffsetS);
+  // A weak prior, not bounds (Ceres' bounds double the Jacobian evaluations): it holds δ near 0
+  // where the motion cannot tell it (a hover) and leaves it free where it can.
+  problem->AddPrior(std::make_unique<DiagonalPrior>(clock_offset, Eigen::VectorXd::Zero(1),
+                                                    Eigen::VectorXd::Constant(1, kClockOffsetPriorSigmaS)));
   return problem;
 }
 
@@ -338,7 +341,7 @@ RotorIdentification IdentifyPiece(const RotorFlight& flight, size_t first, size_
     const double telemetry_offset = clock_offset;
     problem = BuildProblem(flight, first, last, model, o, true, &huber, o.estimate_clock_offset ? &clock_offset : nullptr);
     AddDynamics<true>(*problem, model, o, theta.data());
-    problem->AddPrior(std::make_unique<ThetaPrior>(theta.data(), RotorNominal::PublishedTheta(), PriorSigma()));
+    problem->AddPrior(std::make_unique<DiagonalPrior>(theta.data(), RotorNominal::PublishedTheta(), PriorSigma()));
     problem->ceres_problem().SetManifold(theta.data(), &hold_yaw_inertia);
     for (int i = 0; i < 2; ++i) {  // a rigid body's inertia is positive: at least 1 % of the published one
       problem->ceres_problem().SetParameterLowerBound(theta.data(), kThetaInertiaX + i, 0.01);

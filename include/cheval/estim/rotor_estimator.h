@@ -59,7 +59,7 @@ struct RotorEstimateOptions {
   /// Estimation: estimate the offset δ between the onboard clock (attitude, body rates) and the motion
   /// capture's (positions; the rotor telemetry shares it) with the trajectory, and give the rotor
   /// speeds in the motion capture's time. On the shared flights the onboard samples arrive 0–30 ms
-  /// late, differently on each (docs/estimator_real_data.md, "Two clocks"). |δ| <= kMaxClockOffsetS.
+  /// late, differently on each (docs/estimator_real_data.md, "Two clocks"); kClockOffsetPriorSigmaS.
   bool estimate_clock_offset = true;
   /// Levenberg–Marquardt iterations (>= 1). On the shared flights the rotor speeds after 6 iterations
   /// differ from those after 30 by < 0.1 % of the speed (docs/estimator_real_data.md).
@@ -75,8 +75,10 @@ struct RotorEstimateOptions {
   void Validate() const;
 };
 
-/// The largest clock offset EstimateRotors considers, s (its positions are expanded to second order in δ).
-inline constexpr double kMaxClockOffsetS = 0.1;
+/// σ of the weak prior on the clock offset δ, s: it decides δ only where the motion does not (a hover).
+/// The positions are expanded to second order in δ (internal/delayed_position_cost.h), good to 0.2 mm
+/// up to |δ| = 30 ms at a jerk of 50 m/s³.
+inline constexpr double kClockOffsetPriorSigmaS = 0.05;
 
 /// Revolutions per minute in one rad/s: the rotor speeds are rad/s inside, rpm where people read them.
 inline constexpr double kRpmPerRadps = 30.0 / std::numbers::pi;
