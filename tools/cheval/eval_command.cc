@@ -219,7 +219,7 @@ void PrintResult(const Evaluated& e, Eigen::Index ref_poses) {
   }
   fmt::print("{}\n\n", r.title);
   if (!r.ase) {
-    for (const auto& [name, value] : SortedStats(r.stats)) fmt::print("{:>10}\t{:.6f}\n", name, value);
+    for (const auto& [stat, value] : SortedStats(r.stats)) fmt::print("{:>10}\t{:.6f}\n", stat, value);
   } else {
     // The ASE and its parts side by side.
     std::vector<std::pair<std::string, const eval::ErrorStatistics*>> columns = {{"ASE", &r.stats}};
