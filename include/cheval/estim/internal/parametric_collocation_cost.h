@@ -16,6 +16,8 @@
 /// quaternion (LiftRotationJacobian). Without Jacobians (Ceres pricing a step) f is evaluated in
 /// doubles, the same residual at a fraction of the cost.
 
+#include <type_traits>
+
 #include <ceres/jet.h>
 #include <Eigen/Core>
 
@@ -58,42 +60,21 @@ class ParametricCollocationCost : public BlockCost {
   }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    if (jacobians == nullptr) return Defect(parameters, residuals);
+    if (jacobians == nullptr) {  // a step's cost: the model in doubles
+      double f[3];
+      ModelRate(parameters, f);
+      WriteResidual(parameters, Eigen::Map<const Eigen::Vector3d>(f), residuals);
+      return true;
+    }
     const int N = degree_;
     using Jet = ceres::Jet<double, kJet>;
-    Jet x[9], u[4], u_dot[4], theta[kRotorThetaSize], x_dot[9];
-    int next = N + 1;
-    for (int i = 0; i < 3; ++i) x[3 * part_ + i] = Jet(parameters[j_][i], 3 * part_ + i);
-    for (int b = 0; b < 3; ++b) {
-      if (b == part_) continue;
-      for (int i = 0; i < 3; ++i) x[3 * b + i] = Jet(parameters[next][i], 3 * b + i);
-      ++next;
-    }
-    const double* q = parameters[next++];
-    const int controls = next;
-    const double* u_j = parameters[controls + (all_controls_ ? j_ : 0)];
-    Eigen::Vector4d rate = Eigen::Vector4d::Zero();
-    if (all_controls_) {
-      for (int k = 0; k <= N; ++k) rate += scale_ * d_[k] * Eigen::Map<const Eigen::Vector4d>(parameters[controls + k]);
-    }
-    next += all_controls_ ? N + 1 : 1;
-    for (int i = 0; i < 4; ++i) {
-      u[i] = Jet(u_j[i], 12 + i);
-      u_dot[i] = Jet(rate[i], 16 + i);
-    }
-    for (int i = 0; i < kRotorThetaSize; ++i) {
-      if constexpr (kIdentify) theta[i] = Jet(parameters[next][i], 20 + i);
-      else theta[i] = Jet(theta_[i]);
-    }
-    Eigen::Matrix<Jet, 3, 1> delta;
-    for (int i = 0; i < 3; ++i) delta[i] = Jet(0.0, 9 + i);
-    const Eigen::Matrix<Jet, 3, 3> R = QuaternionMatrix(q).cast<Jet>() * lie::SO3<Jet>::Exp(delta).Matrix();
-    RotorDynamics(nominal_, x, R, u, u_dot, theta, x_dot);
+    Jet f_jet[3];
+    ModelRate(parameters, f_jet);
     Eigen::Vector3d f;
-    for (int i = 0; i < 3; ++i) f[i] = x_dot[3 * part_ + i].a;
+    for (int i = 0; i < 3; ++i) f[i] = f_jet[i].a;
     WriteResidual(parameters, f, residuals);
     Eigen::Matrix<double, 3, kJet> df;
-    for (int i = 0; i < 3; ++i) df.row(i) = x_dot[3 * part_ + i].v.transpose();
+    for (int i = 0; i < 3; ++i) df.row(i) = f_jet[i].v.transpose();
     df *= -inv_sigma_;
     using RowMajor3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
     using RowMajor34 = Eigen::Matrix<double, 3, 4, Eigen::RowMajor>;
@@ -103,7 +84,7 @@ class ParametricCollocationCost : public BlockCost {
       if (k == j_) J += df.template block<3, 3>(0, 3 * part_);
       Eigen::Map<RowMajor3>{jacobians[k]} = J;
     }
-    next = N + 1;
+    int next = N + 1;
     for (int b = 0; b < 3; ++b) {
       if (b == part_) continue;
       if (jacobians[next]) Eigen::Map<RowMajor3>{jacobians[next]} = df.template block<3, 3>(0, 3 * b);
@@ -111,7 +92,7 @@ class ParametricCollocationCost : public BlockCost {
     }
     if (jacobians[next]) {
       const RowMajor3 Jd = df.template block<3, 3>(0, 9);
-      LiftRotationJacobian(q, Jd.data(), 3, jacobians[next]);
+      LiftRotationJacobian(parameters[next], Jd.data(), 3, jacobians[next]);
     }
     ++next;
     if (all_controls_) {  // u_j directly, and u'_j = scale Σ_k d_k u_k
@@ -142,30 +123,53 @@ class ParametricCollocationCost : public BlockCost {
     Eigen::Map<Eigen::Vector3d>{residuals} = inv_sigma_ * r;
   }
 
-  // The residual alone (a step's cost), in doubles: the same blocks as Evaluate reads.
-  bool Defect(double const* const* parameters, double* residuals) const {
+  // f_b at node j from the parameter blocks, every input as T: with T = ceres::Jet the inputs carry
+  // the derivative slots x 0–8, δ 9–11 (the rotation's tangent at R_j), u 12–15, u' 16–19, θ 20–;
+  // with T = double they are the values.
+  template <class T>
+  void ModelRate(double const* const* parameters, T* f) const {
+    const auto input = [](double value, int slot) {
+      if constexpr (std::is_same_v<T, double>) {
+        return value;
+      } else {
+        return T(value, slot);
+      }
+    };
     const int N = degree_;
-    double x[9], x_dot[9];
-    for (int i = 0; i < 3; ++i) x[3 * part_ + i] = parameters[j_][i];
+    T x[9], u[4], u_dot[4], theta[kRotorThetaSize], x_dot[9];
+    for (int i = 0; i < 3; ++i) x[3 * part_ + i] = input(parameters[j_][i], 3 * part_ + i);
     int next = N + 1;
     for (int b = 0; b < 3; ++b) {
       if (b == part_) continue;
-      for (int i = 0; i < 3; ++i) x[3 * b + i] = parameters[next][i];
+      for (int i = 0; i < 3; ++i) x[3 * b + i] = input(parameters[next][i], 3 * b + i);
       ++next;
     }
-    const Eigen::Matrix3d R = QuaternionMatrix(parameters[next++]);
+    const double* q = parameters[next++];
     const int controls = next;
+    const double* u_j = parameters[controls + (all_controls_ ? j_ : 0)];
     Eigen::Vector4d rate = Eigen::Vector4d::Zero();
     if (all_controls_) {
       for (int k = 0; k <= N; ++k) rate += scale_ * d_[k] * Eigen::Map<const Eigen::Vector4d>(parameters[controls + k]);
     }
-    const double* u = parameters[controls + (all_controls_ ? j_ : 0)];
     next += all_controls_ ? N + 1 : 1;
-    const double* theta = theta_.data();
-    if constexpr (kIdentify) theta = parameters[next];
-    RotorDynamics(nominal_, x, R, u, rate.data(), theta, x_dot);
-    WriteResidual(parameters, Eigen::Map<const Eigen::Vector3d>(x_dot + 3 * part_), residuals);
-    return true;
+    for (int i = 0; i < 4; ++i) {
+      u[i] = input(u_j[i], 12 + i);
+      u_dot[i] = input(rate[i], 16 + i);
+    }
+    for (int i = 0; i < kRotorThetaSize; ++i) {
+      if constexpr (kIdentify) theta[i] = input(parameters[next][i], 20 + i);
+      else theta[i] = T(theta_[i]);
+    }
+    Eigen::Matrix<T, 3, 3> R;
+    if constexpr (std::is_same_v<T, double>) {
+      R = QuaternionMatrix(q);
+    } else {
+      Eigen::Matrix<T, 3, 1> delta;
+      for (int i = 0; i < 3; ++i) delta[i] = input(0.0, 9 + i);
+      R = QuaternionMatrix(q).cast<T>() * lie::SO3<T>::Exp(delta).Matrix();
+    }
+    RotorDynamics(nominal_, x, R, u, u_dot, theta, x_dot);
+    for (int i = 0; i < 3; ++i) f[i] = x_dot[3 * part_ + i];
   }
 
   RotorNominal nominal_;
