@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <map>
 #include <memory>
 
 #include <ceres/covariance.h>
@@ -16,7 +15,6 @@
 #include "cheval/cheb/chebyshev.h"
 #include "cheval/common/error.h"
 #include "cheval/common/options.h"
-#include "cheval/estim/internal/delayed_position_cost.h"
 #include "cheval/estim/internal/parametric_collocation_cost.h"
 #include "cheval/estim/problem.h"
 #include "rotor_internal.h"
@@ -178,16 +176,9 @@ std::unique_ptr<Problem> BuildProblem(const RotorFlight& flight, size_t first, s
     problem->AddMeasurements(position_times, std::move(positions), 3, 3, {0}, loss, false);
     return problem;
   }
-  std::map<int, std::vector<internal::DelayedPositionCost::Sample>> by_segment;
-  for (size_t i = 0; i < position_times.size(); ++i) {
-    internal::TimeRow row = problem->RowAt(position_times[i]);
-    const int segment = row.segment;
-    by_segment[segment].push_back({std::move(row), positions[i].measured});
-  }
-  for (auto& [segment, samples] : by_segment) {
-    problem->AddPrior(std::make_unique<internal::DelayedPositionCost>(problem->SegmentOf(segment), std::move(samples), 0,
-                                                                      1, o.position_sigma_m, loss, clock_offset));
-  }
+  std::vector<Eigen::Vector3d> measured;
+  for (const VectorMeasurement& position : positions) measured.push_back(position.measured);
+  problem->AddDelayedPositions(position_times, measured, 0, 1, o.position_sigma_m, loss, clock_offset);
   // A weak prior, not bounds (Ceres' bounds double the Jacobian evaluations): it holds δ near 0
   // where the motion cannot tell it (a hover) and leaves it free where it can.
   problem->AddPrior(std::make_unique<DiagonalPrior>(clock_offset, Eigen::VectorXd::Zero(1),

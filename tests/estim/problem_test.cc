@@ -17,7 +17,6 @@
 #include "../support/residual_only.h"
 #include "cheval/cheb/chebyshev.h"
 #include "cheval/common/error.h"
-#include "cheval/estim/internal/delayed_position_cost.h"
 #include "cheval/estim/models.h"
 #include "cheval/estim/problem.h"
 #include "cheval/lie/so3.h"
@@ -409,15 +408,15 @@ TEST(PseudoSpectralProblem, DelayedPositionsMeetTheTrajectoryAtTheirClockOffset)
   }
   double offset = 0;
   ceres::HuberLoss loss(3.0);
+  std::vector<double> times;
+  std::vector<Eigen::Vector3d> measured;
   for (int s = 0; s < 2; ++s) {
-    std::vector<internal::DelayedPositionCost::Sample> samples;
     for (int i = 0; i < 20; ++i) {
-      const double t = s + 0.013 + 0.049 * i;
-      samples.push_back({problem.RowAt(t), MassPosition(t + true_offset)});
+      times.push_back(s + 0.013 + 0.049 * i);
+      measured.push_back(MassPosition(times.back() + true_offset));
     }
-    problem.AddPrior(std::make_unique<internal::DelayedPositionCost>(problem.SegmentOf(s), std::move(samples), 0, 1,
-                                                                     sigma, &loss, &offset));
   }
+  problem.AddDelayedPositions(times, measured, 0, 1, sigma, &loss, &offset);
   const auto cost = [&] {
     double c = 0;
     problem.ceres_problem().Evaluate(ceres::Problem::EvaluateOptions(), &c, nullptr, nullptr, nullptr);

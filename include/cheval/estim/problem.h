@@ -40,6 +40,7 @@
 #include "cheval/estim/internal/collocation_cost.h"
 #include "cheval/estim/internal/control_rate_cost.h"
 #include "cheval/estim/internal/control_rows_cost.h"
+#include "cheval/estim/internal/delayed_position_cost.h"
 #include "cheval/estim/internal/derivative_measurement_cost.h"
 #include "cheval/estim/internal/measurement_cost.h"
 #include "cheval/estim/internal/segment.h"
@@ -266,16 +267,31 @@ class PseudoSpectralProblem {
                        bool uses_rotation = true) {
     using Cost = internal::MeasurementCost<Model, F>;
     if (times.size() != functors.size()) throw UsageError("AddMeasurements: one functor per time");
-    std::map<int, std::vector<typename Cost::Sample>> by_segment;
-    for (size_t i = 0; i < times.size(); ++i) {
-      internal::TimeRow row = RowAt(times[i]);
-      const int s = row.segment;
-      by_segment[s].push_back({std::move(row), std::move(functors[i])});
-    }
-    for (auto& [s, samples] : by_segment) {
+    for (auto& [s, rows_of] : RowsBySegment(times)) {
+      std::vector<typename Cost::Sample> samples;
+      for (auto& [i, row] : rows_of) samples.push_back({std::move(row), std::move(functors[i])});
       AddMeasurementCost(s, std::make_unique<Cost>(SegmentOf(s), std::move(samples), rows, group_rows, used_blocks,
                                                    loss, uses_rotation),
                          uses_rotation);
+    }
+  }
+
+  /// Adds positions stamped by a clock δ behind the problem's: `measured[i]` is the position at
+  /// problem time times[i] + δ, from the vector blocks `position_block` and `velocity_block` (blocks
+  /// of 3), σ `sigma` and a robust `loss` per sample (may be null, not owned), δ the parameter block
+  /// `delay` (1 number, seconds) — one internal/delayed_position_cost.h block per segment. Throws
+  /// UsageError when the sizes differ or the blocks are not of 3, ComputeError when a time is outside
+  /// the interval.
+  void AddDelayedPositions(const std::vector<double>& times, const std::vector<Eigen::Vector3d>& measured,
+                           int position_block, int velocity_block, double sigma, const ceres::LossFunction* loss,
+                           double* delay) {
+    if (times.size() != measured.size()) throw UsageError("AddDelayedPositions: one position per time");
+    if (Model::kBlockSize != 3) throw UsageError("AddDelayedPositions: the model's vector blocks must be of 3");
+    for (auto& [s, rows_of] : RowsBySegment(times)) {
+      std::vector<internal::DelayedPositionCost::Sample> samples;
+      for (auto& [i, row] : rows_of) samples.push_back({std::move(row), measured[i]});
+      Add(std::make_unique<internal::DelayedPositionCost>(SegmentOf(s), std::move(samples), position_block,
+                                                          velocity_block, sigma, loss, delay));
     }
   }
 
@@ -443,6 +459,17 @@ class PseudoSpectralProblem {
   PriorId Add(std::unique_ptr<internal::BlockCost> cost, ceres::LossFunction* loss = nullptr) {
     const std::vector<double*> blocks = cost->blocks();
     return problem_->AddResidualBlock(cost.release(), loss, blocks);
+  }
+
+  // The indices of `times` by the segment of their time, each with its rows (in the order given).
+  std::map<int, std::vector<std::pair<size_t, internal::TimeRow>>> RowsBySegment(const std::vector<double>& times) const {
+    std::map<int, std::vector<std::pair<size_t, internal::TimeRow>>> out;
+    for (size_t i = 0; i < times.size(); ++i) {
+      internal::TimeRow row = RowAt(times[i]);
+      const int s = row.segment;
+      out[s].emplace_back(i, std::move(row));
+    }
+    return out;
   }
 
   // A measurement's cost on segment s; its rotations (when it uses them) get the quaternion manifold.
