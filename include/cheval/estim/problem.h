@@ -248,12 +248,7 @@ class PseudoSpectralProblem {
   template <class F>
   void AddMeasurement(double t, F functor, int rows, int group_rows, const std::vector<int>& used_blocks,
                       const ceres::LossFunction* loss = nullptr, bool uses_rotation = true) {
-    internal::TimeRow row = RowAt(t);
-    const int s = row.segment;
-    AddMeasurementCost(s, std::make_unique<internal::MeasurementCost<Model, F>>(
-                              SegmentOf(s), std::move(row), std::move(functor), rows, group_rows, used_blocks, loss,
-                              uses_rotation),
-                       uses_rotation);
+    AddMeasurements({t}, std::vector<F>{std::move(functor)}, rows, group_rows, used_blocks, loss, uses_rotation);
   }
 
   /// Adds the measurements h_i(x(t_i)) (`functors[i]` at `times[i]`, as AddMeasurement's, `rows` each)
@@ -270,9 +265,15 @@ class PseudoSpectralProblem {
     for (auto& [s, rows_of] : RowsBySegment(times)) {
       std::vector<typename Cost::Sample> samples;
       for (auto& [i, row] : rows_of) samples.push_back({std::move(row), std::move(functors[i])});
-      AddMeasurementCost(s, std::make_unique<Cost>(SegmentOf(s), std::move(samples), rows, group_rows, used_blocks,
-                                                   loss, uses_rotation),
-                         uses_rotation);
+      auto cost = std::make_unique<Cost>(SegmentOf(s), std::move(samples), rows, group_rows, used_blocks, loss,
+                                         uses_rotation);
+      ceres::LossFunction* ceres_loss = cost->ceres_loss();
+      Add(std::move(cost), ceres_loss);
+      if constexpr (kRotation) {  // its rotations get the quaternion manifold
+        if (uses_rotation) {
+          for (int k = 0; k <= degree_; ++k) UseManifold(NodeOf(s, k));
+        }
+      }
     }
   }
 
@@ -470,18 +471,6 @@ class PseudoSpectralProblem {
       out[s].emplace_back(i, std::move(row));
     }
     return out;
-  }
-
-  // A measurement's cost on segment s; its rotations (when it uses them) get the quaternion manifold.
-  template <class Cost>
-  void AddMeasurementCost(int s, std::unique_ptr<Cost> cost, bool uses_rotation) {
-    ceres::LossFunction* ceres_loss = cost->ceres_loss();
-    Add(std::move(cost), ceres_loss);
-    if constexpr (kRotation) {
-      if (uses_rotation) {
-        for (int k = 0; k <= degree_; ++k) UseManifold(NodeOf(s, k));
-      }
-    }
   }
 
   SmoothnessPrior& Smoothness(int order) {

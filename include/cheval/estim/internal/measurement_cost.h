@@ -54,17 +54,11 @@ class MeasurementCost : public BlockCost {
     F functor;
   };
 
-  /// One measurement. `used`: the vector blocks h depends on (the others are read from the segment's
-  /// storage and held); `uses_rotation`: whether h depends on R (models with a rotation). `loss` may
-  /// be null; it is not owned. Throws UsageError for rows that are not a positive multiple of
-  /// group_rows or a block that does not exist.
-  MeasurementCost(const Segment& segment, TimeRow row, F functor, int rows, int group_rows, std::vector<int> used,
-                  const ceres::LossFunction* loss, bool uses_rotation = true)
-      : MeasurementCost(segment, std::vector<Sample>{Sample{std::move(row), std::move(functor)}}, rows, group_rows,
-                        std::move(used), loss, uses_rotation) {}
-
-  /// A batch of measurements in `segment`, `rows` each (the loss applies per group of each); as above.
-  /// Also throws UsageError for an empty batch or a sample of another segment.
+  /// Measurements in `segment` (one or a batch), `rows` each (the loss applies per group of each).
+  /// `used`: the vector blocks h depends on (the others are read from the segment's storage and
+  /// held); `uses_rotation`: whether h depends on R (models with a rotation). `loss` may be null; it
+  /// is not owned. Throws UsageError for rows that are not a positive multiple of group_rows, a block
+  /// that does not exist, no samples or a sample of another segment.
   MeasurementCost(const Segment& segment, std::vector<Sample> samples, int rows, int group_rows,
                   std::vector<int> used, const ceres::LossFunction* loss, bool uses_rotation = true)
       : storage_(segment.vector), reference_(segment.reference), samples_(std::move(samples)), rows_(rows),
