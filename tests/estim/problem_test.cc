@@ -433,6 +433,59 @@ TEST(PseudoSpectralProblem, DelayedPositionsMeetTheTrajectoryAtTheirClockOffset)
   EXPECT_EQ(problem.num_represented_rows(), 3 * 40);
 }
 
+// An accelerometer-like measurement of v' = x'[3..6) of the point mass, against a measured value.
+struct MassAcceleration {
+  Eigen::Vector3d measured;
+  template <typename T>
+  bool operator()(const T* x_dot, T* r) const {
+    for (int i = 0; i < 3; ++i) r[i] = (x_dot[3 + i] - T(measured[i])) * T(2.0);
+    return true;
+  }
+};
+
+// Derivative measurements added as batches (one compressed block per segment, only the velocity
+// blocks) have the cost, gradient and Gauss–Newton matrix of the same measurements added one by one
+// (every block, a loss per sample); a step is priced as the linearisation says, and the degrees of
+// freedom count every sample's rows.
+TEST(PseudoSpectralProblem, DerivativeMeasurementBatchKeepsNormalEquations) {
+  ceres::HuberLoss loss(0.5);
+  const auto mass_problem = [] {
+    PseudoSpectralProblem<PointMassModel> problem(PointMassModel{}, {0.0, 1.0, 2.0}, 6);
+    for (int g = 0; g < problem.num_nodes(); ++g) {
+      const double t = problem.NodeTime(g);
+      Eigen::VectorXd x(6);
+      x << MassPosition(t), MassVelocity(t) * (1 + 0.1 * g);  // off the trajectory: residuals of all sizes
+      problem.SetNode(g, x, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+    }
+    problem.AddCollocation(Eigen::Matrix<double, 6, 1>::Ones());  // the same in both: every block in the problem
+    return problem;
+  };
+  auto one_by_one = mass_problem(), batched = mass_problem();
+  std::vector<double> times;
+  std::vector<MassAcceleration> measured;
+  for (int i = 0; i < 30; ++i) {
+    times.push_back(0.01 + 1.98 * i / 29);
+    measured.push_back({Eigen::Vector3d(-std::sin(times.back()), 2, 0.3 * i)});
+    one_by_one.AddDerivativeMeasurement(times.back(), measured.back(), 3, &loss);
+  }
+  batched.AddDerivativeMeasurements(times, measured, 3, 3, {1}, &loss);
+  std::vector<ceres::ResidualBlockId> ids;
+  batched.ceres_problem().GetResidualBlocks(&ids);
+  std::vector<ceres::ResidualBlockId> collocation_ids;
+  mass_problem().ceres_problem().GetResidualBlocks(&collocation_ids);
+  EXPECT_EQ(ids.size() - collocation_ids.size(), 2u);  // one block per segment
+  EXPECT_EQ(batched.num_represented_rows(), one_by_one.num_represented_rows());
+  const Normal a = NormalEquations(one_by_one), b = NormalEquations(batched);
+  EXPECT_NEAR(a.cost, b.cost, 1e-10 * a.cost);
+  EXPECT_LT((a.gradient - b.gradient).cwiseAbs().maxCoeff(), 1e-10 * a.gradient.cwiseAbs().maxCoeff());
+  EXPECT_LT((a.JtJ - b.JtJ).cwiseAbs().maxCoeff(), 1e-10 * a.JtJ.cwiseAbs().maxCoeff());
+  ExpectGradientMatchesDifferences(batched);
+  EXPECT_EQ(cheval::testing::ExpectResidualOnlyEvaluationMatches(batched.ceres_problem()),
+            static_cast<int>(collocation_ids.size()) + 2);
+  EXPECT_THROW(batched.AddDerivativeMeasurements({0.5}, std::vector<MassAcceleration>{}, 3, 3, {1}), UsageError);
+  EXPECT_THROW(batched.AddDerivativeMeasurements({0.5}, std::vector<MassAcceleration>(1), 3, 3, {2}), UsageError);
+}
+
 TEST(PseudoSpectralProblem, OutsideIntervalIsAnError) {
   auto problem = AttitudeProblem(6, false);
   PointObservation obs{{{1, 2, 3}}};

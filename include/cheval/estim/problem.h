@@ -16,7 +16,7 @@
 ///
 /// Residuals, each a small cost class with its contract in include/cheval/estim/internal/:
 /// AddCollocation (collocation_cost.h), AddMeasurement (measurement_cost.h),
-/// AddDerivativeMeasurement (derivative_measurement_cost.h). Priors go through one interface,
+/// AddDerivativeMeasurement(s) (derivative_measurement_cost.h). Priors go through one interface,
 /// AddPrior / RemovePrior; the control priors AddControlSmoothnessPrior (control_rows_cost.h) and
 /// AddControlRatePrior (control_rate_cost.h) are built on it. A prior that is not wanted is not added.
 
@@ -297,14 +297,33 @@ class PseudoSpectralProblem {
   }
 
   /// Adds a residual h(x'(t)) of the vector part's derivative at t
-  /// (internal/derivative_measurement_cost.h). `F` has
-  /// `template <class T> bool operator()(const T* x_dot, T* residual) const` with `rows` residuals.
+  /// (internal/derivative_measurement_cost.h), `loss` over all its rows (may be null; not owned).
+  /// `F` has `template <class T> bool operator()(const T* x_dot, T* residual) const` with `rows`
+  /// residuals, and may read every vector block.
   template <class F>
-  void AddDerivativeMeasurement(double t, F functor, int rows, ceres::LossFunction* loss = nullptr) {
-    internal::TimeRow row = RowAt(t);
-    const internal::Segment segment = SegmentOf(row.segment);
-    Add(std::make_unique<internal::DerivativeMeasurementCost<Model, F>>(segment, std::move(row), std::move(functor), rows),
-        loss);
+  void AddDerivativeMeasurement(double t, F functor, int rows, const ceres::LossFunction* loss = nullptr) {
+    std::vector<int> every_block(kBlocks);
+    for (int b = 0; b < kBlocks; ++b) every_block[b] = b;
+    AddDerivativeMeasurements({t}, std::vector<F>{std::move(functor)}, rows, rows, every_block, loss);
+  }
+
+  /// Adds the residuals h_i(x'(t_i)) (`functors[i]` at `times[i]`, `rows` each, in groups of
+  /// `group_rows` sharing one robust `loss`, which may be null and is not owned) as one compressed
+  /// residual block per segment (internal/derivative_measurement_cost.h): the same cost, gradient
+  /// and Gauss–Newton matrix as adding them one by one. `used_blocks` lists the vector blocks h reads.
+  /// Throws UsageError when the sizes differ, ComputeError when a time is outside the interval.
+  template <class F>
+  void AddDerivativeMeasurements(const std::vector<double>& times, std::vector<F> functors, int rows, int group_rows,
+                                 const std::vector<int>& used_blocks, const ceres::LossFunction* loss = nullptr) {
+    using Cost = internal::DerivativeMeasurementCost<Model, F>;
+    if (times.size() != functors.size()) throw UsageError("AddDerivativeMeasurements: one functor per time");
+    for (auto& [s, rows_of] : RowsBySegment(times)) {
+      std::vector<typename Cost::Sample> samples;
+      for (auto& [i, row] : rows_of) samples.push_back({std::move(row), std::move(functors[i])});
+      auto cost = std::make_unique<Cost>(SegmentOf(s), std::move(samples), rows, group_rows, used_blocks, loss);
+      ceres::LossFunction* ceres_loss = cost->ceres_loss();
+      Add(std::move(cost), ceres_loss);
+    }
   }
 
   /// Adds a prior: any cost on the problem's blocks (its blocks() point into this problem's node

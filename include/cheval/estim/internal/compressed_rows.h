@@ -1,18 +1,44 @@
 #pragma once
 /// \file
-/// The compression of a cost's rows that measurement_cost.h and delayed_position_cost.h share: rows r
+/// What the batched costs share (measurement_cost.h, derivative_measurement_cost.h,
+/// delayed_position_cost.h): the check of a batch's arguments, and the compression of its rows: rows r
 /// with Jacobian J, in groups of `group_rows` that share one robust loss ρ, become
 /// [Q₁ᵀ r; sqrt(Σρ − |Q₁ᵀ r|²)] with Jacobian [T; 0] (J = Q [T; 0] after the IRLS weights √ρ' of the
 /// loss) — the same cost, gradient and Gauss–Newton matrix in min(rows, columns) + 1 rows.
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include <ceres/loss_function.h>
 #include <Eigen/Core>
 #include <Eigen/QR>
 
+#include "cheval/common/error.h"
+
 namespace cheval::estim::internal {
+
+/// The arguments of a batch of measurements (one residual block for several times of one segment,
+/// `rows` each in groups of `group_rows` sharing a loss, reading the vector blocks `used` of `blocks`):
+/// throws UsageError, naming `what`, for rows that are not a positive multiple of group_rows, a block
+/// that does not exist, no samples or a sample (`.row.segment`) of another segment.
+template <class Samples>
+void CheckBatch(const std::string& what, int rows, int group_rows, const std::vector<int>& used, int blocks,
+                const Samples& samples) {
+  if (rows < 1 || group_rows < 1 || rows % group_rows != 0) {
+    throw UsageError(what + " rows must be a positive multiple of the group size");
+  }
+  for (int b : used) {
+    if (b < 0 || b >= blocks) throw UsageError(what + " uses a vector block that does not exist");
+  }
+  if (samples.empty()) throw UsageError("a " + what + " batch needs at least one sample");
+  for (const auto& sample : samples) {
+    if (sample.row.segment != samples.front().row.segment) {
+      throw UsageError("the " + what + "s of a batch must lie in one segment");
+    }
+  }
+}
 
 /// Σ ρ(|r_g|²) over the groups of `rows` residuals (Σ |r_g|² without a loss).
 inline double GroupedCost(const double* r, int rows, int group_rows, const ceres::LossFunction* loss) {

@@ -63,18 +63,7 @@ class MeasurementCost : public BlockCost {
                   std::vector<int> used, const ceres::LossFunction* loss, bool uses_rotation = true)
       : storage_(segment.vector), reference_(segment.reference), samples_(std::move(samples)), rows_(rows),
         group_rows_(group_rows), used_(std::move(used)), loss_(loss), rotation_(kRotation && uses_rotation) {
-    if (rows_ < 1 || group_rows_ < 1 || rows_ % group_rows_ != 0) {
-      throw UsageError("measurement rows must be a positive multiple of the group size");
-    }
-    for (int b : used_) {
-      if (b < 0 || b >= kBlocks) throw UsageError("measurement uses a vector block that does not exist");
-    }
-    if (samples_.empty()) throw UsageError("a measurement batch needs at least one sample");
-    for (const Sample& sample : samples_) {
-      if (sample.row.segment != samples_.front().row.segment) {
-        throw UsageError("the measurements of a batch must lie in one segment");
-      }
-    }
+    CheckBatch("measurement", rows_, group_rows_, used_, kBlocks, samples_);
     local_dim_ = static_cast<int>(used_.size()) * kBlock + (rotation_ ? 3 : 0);
     batch_ = samples_.size() > 1;
     columns_ = batch_ ? (segment.degree() + 1) * local_dim_ : local_dim_;
