@@ -53,6 +53,18 @@ struct VectorMeasurement {
   }
 };
 
+// The accelerometer's world-frame specific force a against the trajectory's v' − g (x_dot's entries
+// [3, 6): v'), whitened.
+struct SpecificForceMeasurement {
+  Eigen::Vector3d acceleration;  // a + g: what v' should be
+  double inv_sigma;
+  template <typename T>
+  bool operator()(const T* x_dot, T* r) const {
+    for (int i = 0; i < 3; ++i) r[i] = (x_dot[3 + i] - T(acceleration[i])) * T(inv_sigma);
+    return true;
+  }
+};
+
 // (x − x0) / σ on a block of numbers: the weak priors of θ (identification) and the clock offset.
 class DiagonalPrior : public internal::BlockCost {
  public:
@@ -172,6 +184,11 @@ std::unique_ptr<Problem> BuildProblem(const RotorFlight& flight, size_t first, s
   }
   problem->AddMeasurements(times, std::move(attitudes), 3, 3, {}, loss);
   problem->AddMeasurements(times, std::move(rates), 3, 3, {2}, loss, false);
+  if (o.use_accelerometer && !measured_rotors) {
+    std::vector<SpecificForceMeasurement> forces;
+    for (size_t i = first; i <= last; ++i) forces.push_back({s[i].accel + g, 1.0 / o.accelerometer_sigma_mps2});
+    problem->AddDerivativeMeasurements(times, std::move(forces), 3, 3, {1}, loss);
+  }
   if (clock_offset == nullptr) {
     problem->AddMeasurements(position_times, std::move(positions), 3, 3, {0}, loss, false);
     return problem;
@@ -241,6 +258,7 @@ void RotorEstimateOptions::Validate() const {
         sigma_angular_acceleration);
   check(positive(sigma_rotation_rate), "sigma_rotation_rate", "must be > 0, got {}", sigma_rotation_rate);
   check(positive(sigma_rotor_rate), "sigma_rotor_rate", "must be > 0, got {}", sigma_rotor_rate);
+  check(positive(accelerometer_sigma_mps2), "accelerometer_sigma_mps2", "must be > 0, got {}", accelerometer_sigma_mps2);
   check(positive(baseline_window_s), "baseline_window_s", "must be > 0, got {}", baseline_window_s);
   check(identification_piece_s >= 1 && std::isfinite(identification_piece_s), "identification_piece_s",
         "must be at least 1 s, got {}", identification_piece_s);

@@ -97,6 +97,10 @@ TEST_F(RotorsCliTest, OptionOutOfRangeIsExit1NamingTheFlag) {
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("--degree must be in [2, 20], got 1"), std::string::npos) << r.err;
   ExpectNoOutputs();
+  r = Cheval(fmt::format("estimate rotors --data {} --vehicle {} --accelerometer-sigma 0 {}", flight, kVehicle, Outputs()));
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("--accelerometer-sigma must be > 0, got 0"), std::string::npos) << r.err;
+  ExpectNoOutputs();
   r = Cheval(fmt::format("identify rotors --data {} --vehicle {} --piece 0.5 -o {}", flight, kVehicle, Path("v.json")));
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("--piece must be at least 1 s, got 0.5"), std::string::npos) << r.err;

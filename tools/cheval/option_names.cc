@@ -96,6 +96,8 @@ constexpr std::array kFlags = std::to_array<OptionName>({
     {"RotorEstimateOptions::max_iterations", "--max-iterations"},
     {"RotorEstimateOptions::threads", "--threads"},
     {"RotorEstimateOptions::estimate_clock_offset", "--no-clock-offset"},
+    {"RotorEstimateOptions::use_accelerometer", "--no-accelerometer"},
+    {"RotorEstimateOptions::accelerometer_sigma_mps2", "--accelerometer-sigma"},
 });
 
 // evo's spellings (evo_ape / evo_rpe / evo_traj 1.36.5 argparse names), one table for the CLI's

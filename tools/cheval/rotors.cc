@@ -68,6 +68,11 @@ void RegisterEstimateRotors(CLI::App& app, Action* action) {
   rotors->add_option("--sigma-rotor-rate", flags->options.sigma_rotor_rate,
                      "Smoothness prior of the rotor speeds (rad/s^2 per s^0.5)")
       ->capture_default_str();
+  rotors->add_flag("!--no-accelerometer", flags->options.use_accelerometer,
+                   "Do not use the accelerometer (ax,ay,az: world-frame specific force) as a measurement");
+  rotors->add_option("--accelerometer-sigma", flags->options.accelerometer_sigma_mps2,
+                     "Sigma of an accelerometer sample per axis (m/s^2)")
+      ->capture_default_str();
   rotors->add_option("--json", flags->json, "Write the result as JSON");
   rotors->add_option("-o,--output", flags->output, "Write states and rotor speeds (estimated, measured, baseline) as CSV");
   rotors->add_option("--report", flags->report,

@@ -5,7 +5,8 @@
 /// header naming its columns. The columns used (any order, others ignored):
 /// `t`, `x_mocap,y_mocap,z_mocap` (motion-capture position, world, m), `qw,qx,qy,qz` (onboard
 /// attitude R_world_body, normalised here: the stored ones are not unit), `wx,wy,wz` (body rate,
-/// rad/s), `m1_erpm..m4_erpm` (ESC electrical rpm), `ax,ay,az` (accelerometer, body frame, m/s²),
+/// rad/s), `m1_erpm..m4_erpm` (ESC electrical rpm), `ax,ay,az` (accelerometer: the specific force in the
+/// world frame, m/s², although SOURCE.md says body; docs/estimator_real_data.md, "The accelerometer"),
 /// `is_flying` (0/1).
 
 #include <cstdint>
@@ -34,7 +35,7 @@ struct RotorSample {
   Eigen::Vector3d p = Eigen::Vector3d::Zero();            ///< motion-capture position, world, m
   Eigen::Quaterniond q = Eigen::Quaterniond::Identity();  ///< R_world_body, unit
   Eigen::Vector3d w = Eigen::Vector3d::Zero();            ///< body rate, rad/s
-  Eigen::Vector3d accel = Eigen::Vector3d::Zero();        ///< accelerometer (specific force), body, m/s²
+  Eigen::Vector3d accel = Eigen::Vector3d::Zero();        ///< accelerometer (specific force), world frame, m/s²
   Eigen::Vector4d rotor = Eigen::Vector4d::Zero();        ///< measured rotor speeds m1..m4, rad/s
   bool flying = false;                                    ///< is_flying
   /// The motion-capture position differs from the previous row's: the capture system delivers

@@ -61,6 +61,12 @@ struct RotorEstimateOptions {
   /// speeds in the motion capture's time. On the shared flights the onboard samples arrive 0–30 ms
   /// late, differently on each (docs/estimator_real_data.md, "Two clocks"); kClockOffsetPriorSigmaS.
   bool estimate_clock_offset = true;
+  /// Estimation: the accelerometer (`ax,ay,az`, the specific force in the world frame) as a
+  /// measurement of the trajectory's acceleration, v' = g + a, with σ accelerometer_sigma_mps2 per
+  /// axis (> 0) and the Huber loss, on the onboard clock. It carries the collective thrust through
+  /// the motion capture's freezes (docs/estimator_real_data.md, "The accelerometer").
+  bool use_accelerometer = true;
+  double accelerometer_sigma_mps2 = 0.5;
   /// Levenberg–Marquardt iterations (>= 1). On the shared flights the rotor speeds after 6 iterations
   /// differ from those after 30 by < 0.1 % of the speed (docs/estimator_real_data.md).
   int max_iterations = 8;
