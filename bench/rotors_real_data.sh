@@ -36,4 +36,25 @@ for f in $FLIGHTS; do
 done
 echo
 cat "$OUT/all.txt"
+# Stability of θ across training sets: per free parameter, the largest |θ(left out) − θ(all 3)| over
+# the three left-out sets, in units of the larger of the two σ.
+python3 - "$OUT" $FLIGHTS <<'PY'
+import json, sys
+out, flights = sys.argv[1], sys.argv[2:]
+ident = lambda path: json.load(open(path))["identified"]
+every = ident(out + "/all.json")
+names = ["k_m1", "k_m2", "k_m3", "k_m4", "J_x", "J_y", "J_z", "k_M", "tau0_x", "tau0_y", "tau0_z",
+         "drag_xy", "drag_z", "moment_x", "moment_y", "rotor_inertia"]  # θ's order (rotor_model.h)
+worst = {}
+for f in flights:
+    left = ident("%s/loo_%s.json" % (out, f))
+    for i, name in enumerate(names):
+        s = max(left["theta_sigma"][i], every["theta_sigma"][i])
+        if s > 0:
+            worst[name] = max(worst.get(name, 0.0), abs(left["theta"][i] - every["theta"][i]) / s)
+print("stability (largest left-out difference / sigma): " + ", ".join("%s %.1f" % kv for kv in worst.items()))
+n = len(worst)
+print("within 1 sigma: %d of %d, 2 sigma: %d, 3 sigma: %d" % tuple([sum(v <= k for v in worst.values()) for k in (1,)] + [n] +
+      [sum(v <= k for v in worst.values()) for k in (2, 3)]))
+PY
 echo "outputs in $OUT"

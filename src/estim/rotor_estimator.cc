@@ -418,6 +418,18 @@ std::vector<std::pair<size_t, size_t>> Pieces(const RotorFlight& flight, const R
 
 }  // namespace
 
+RotorThetaVector BirgeRatios(const std::vector<RotorIdentification>& groups, const RotorThetaVector& theta) {
+  RotorThetaVector ratio = RotorThetaVector::Ones();
+  if (groups.size() < 2) return ratio;
+  for (int i = 0; i < kRotorThetaSize; ++i) {
+    if (groups.front().covariance(i, i) == 0) continue;  // held
+    double q = 0;
+    for (const RotorIdentification& g : groups) q += (g.theta[i] - theta[i]) * (g.theta[i] - theta[i]) / g.covariance(i, i);
+    ratio[i] = std::max(1.0, std::sqrt(q / static_cast<double>(groups.size() - 1)));
+  }
+  return ratio;
+}
+
 RotorIdentification CombineIdentifications(const std::vector<RotorIdentification>& pieces) {
   if (pieces.empty()) throw UsageError("no identification to combine");
   // The product of the pieces' Gaussians, then each parameter's σ scaled by its Birge ratio
@@ -458,18 +470,8 @@ RotorIdentification CombineIdentifications(const std::vector<RotorIdentification
     out.theta[free[a]] = theta[a];
     for (int b = 0; b < n; ++b) out.covariance(free[a], free[b]) = covariance(a, b);
   }
-  out.dispersion = RotorThetaVector::Ones();
-  if (pieces.size() > 1) {
-    for (int i = 0; i < kRotorThetaSize; ++i) {
-      if (out.covariance(i, i) == 0) continue;
-      double q = 0;
-      for (const RotorIdentification& p : pieces) {
-        q += (p.theta[i] - out.theta[i]) * (p.theta[i] - out.theta[i]) / p.covariance(i, i);
-      }
-      out.dispersion[i] = std::max(1.0, std::sqrt(q / static_cast<double>(pieces.size() - 1)));
-    }
-    out.covariance = out.dispersion.asDiagonal() * out.covariance * out.dispersion.asDiagonal();
-  }
+  out.dispersion = BirgeRatios(pieces, out.theta);
+  out.covariance = out.dispersion.asDiagonal() * out.covariance * out.dispersion.asDiagonal();
   out.converged = std::all_of(pieces.begin(), pieces.end(), [](const RotorIdentification& p) { return p.converged; });
   return out;
 }
@@ -480,17 +482,21 @@ RotorVehicle IdentifyRotors(const std::vector<RotorFlight>& flights, const Rotor
   if (flights.empty()) throw UsageError("identification needs at least one flight");
   RotorVehicle out = base;
   out.training.clear();
-  std::vector<RotorIdentification> all;
+  std::vector<RotorIdentification> all, each;
   for (const RotorFlight& flight : flights) {
     std::vector<RotorIdentification> pieces;
     for (const auto& [first, last] : Pieces(flight, options)) pieces.push_back(IdentifyPiece(flight, first, last, base, options));
     all.insert(all.end(), pieces.begin(), pieces.end());
     out.training.push_back(flight.path);
-    if (per_flight) per_flight->push_back(CombineIdentifications(pieces));
+    each.push_back(CombineIdentifications(pieces));
   }
+  if (per_flight) per_flight->insert(per_flight->end(), each.begin(), each.end());
   const RotorIdentification combined = CombineIdentifications(all);
   out.theta = combined.theta;
-  out.theta_sigma = combined.covariance.diagonal().cwiseSqrt();
+  // Between flights: a flight's pieces may agree with each other and not with another flight's (the
+  // battery seated elsewhere moves τ0); σ is widened by the flights' own Birge ratio too, each flight
+  // with its σ from its own pieces.
+  out.theta_sigma = combined.covariance.diagonal().cwiseSqrt().cwiseProduct(BirgeRatios(each, combined.theta));
   return out;
 }
 

@@ -292,6 +292,15 @@ TEST(RotorIdentification, CombinationWidensSigmaByTheDispersion) {
   EXPECT_EQ(c.covariance(6, 6), 0.0);
   EXPECT_EQ(c.theta[6], a.theta[6]);
   EXPECT_THROW(estim::CombineIdentifications({}), UsageError);
+  // The flights' ratio about another θ (IdentifyRotors: each flight's combination about the
+  // combination of every piece): Q = Σ (θ_k − θ)² / σ²_k over k groups, ratio sqrt(Q / (k − 1)).
+  estim::RotorThetaVector about = a.theta;
+  about[11] += 0.3;
+  const estim::RotorThetaVector r = estim::BirgeRatios({a, b}, about);
+  EXPECT_NEAR(r[11], std::sqrt((0.3 * 0.3 + 1.7 * 1.7) / 0.01), 1e-9);
+  EXPECT_NEAR(r[0], 1.0, 1e-12);  // Q = 0.1² / 0.01 = 1: not widened
+  EXPECT_EQ(r[6], 1.0);  // held
+  EXPECT_EQ(estim::BirgeRatios({a}, about)[11], 1.0);  // one group says nothing of the spread
 }
 
 TEST(RotorEstimateOptions, RefusesOutOfRangeFields) {

@@ -152,6 +152,10 @@ struct RotorIdentification {
   bool converged = false;
 };
 
+/// Per parameter, the Birge ratio max(1, sqrt(Q / (k − 1))) of k identifications about θ, Q = Cochran's
+/// Σ (θ_k − θ)² / σ²_k; 1 for a held parameter (zero variance) or fewer than two.
+RotorThetaVector BirgeRatios(const std::vector<RotorIdentification>& groups, const RotorThetaVector& theta);
+
 /// Combines identifications by their information (the product of their Gaussians), then scales each
 /// parameter's σ by its Birge ratio sqrt(Q / (k − 1)) when above 1, Q = Cochran's Σ (θ_piece − θ)² /
 /// σ²_piece: the σ then covers how far apart the pieces are, not only how well each determines θ
@@ -164,8 +168,10 @@ RotorIdentification CombineIdentifications(const std::vector<RotorIdentification
 /// vehicle: σ 1 on the relative entries, 100 units on the others) on each piece of about
 /// identification_piece_s of every flying span, and combines the pieces by CombineIdentifications:
 /// θ's σ then holds how much θ changes from one stretch of flight to another, which the solver's
-/// covariance alone (residuals taken as independent) does not. Returns the vehicle with the combined
-/// θ and σ, and `per_flight` each flight's own combination. ComputeError when a covariance cannot be
+/// covariance alone (residuals taken as independent) does not; with several flights it is widened
+/// again by the flights' Birge ratio (each flight's pieces combined, about the combined θ), for what
+/// changes from one flight to another. Returns the vehicle with the combined θ and σ, and
+/// `per_flight` each flight's own combination. ComputeError when a covariance cannot be
 /// computed.
 RotorVehicle IdentifyRotors(const std::vector<RotorFlight>& flights, const RotorVehicle& base,
                             const RotorEstimateOptions& options, std::vector<RotorIdentification>* per_flight);
