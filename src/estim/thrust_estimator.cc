@@ -383,11 +383,11 @@ ThrustEstimate EstimateThrust(const ThrustFlight& flight, const ThrustEstimateOp
     problem.AddMeasurement(tp[j], PositionResidual{pp[j], options.position_sigma_m}, 3, 3, {0});
   }
   int imu = 0;
-  if (options.use_imu) {
-    for (int i = 0; i < n; ++i) {
-      problem.AddDerivativeMeasurement(t[i], SpecificForceResidual{R[i], f[i], k.gravity_mps2, options.imu_sigma_mps2}, 3);
-      ++imu;
-    }
+  if (options.use_imu) {  // every sample of a segment in one compressed block (AddDerivativeMeasurements)
+    std::vector<SpecificForceResidual> forces;
+    for (int i = 0; i < n; ++i) forces.push_back({R[i], f[i], k.gravity_mps2, options.imu_sigma_mps2});
+    problem.AddDerivativeMeasurements(t, std::move(forces), 3, 3, {1});
+    imu = n;
   }
   problem.HoldControlEntries({1, 2, 3, 4});  // the attitude entries of every control are known inputs
 
