@@ -4,12 +4,14 @@
 #include "end_caps.h"
 #include "jumps.h"
 #include "local_rates.h"
+#include "local_regression.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -60,8 +62,11 @@ class WindowFitter {
   // window that may be split but whose coefficients cannot show it resolved while its residual is
   // consistent with the noise is returned (verdict resolved) with *undecided set: the caller
   // decides by prediction whether to split it (SplitPredictsBetter).
+  // With `missed`, a window that is not returned because its residual fails the lack-of-fit test
+  // sets *missed (it missed motion).
   std::optional<CurveWindow> Fit(double a, double b, double segment_begin, double segment_end, bool may_split,
-                                 Eigen::VectorXd* held_out = nullptr, bool* undecided = nullptr) const {
+                                 Eigen::VectorXd* held_out = nullptr, bool* undecided = nullptr,
+                                 bool* missed = nullptr) const {
     const double extension = options_.overlap * (b - a);
     CurveWindow window;
     window.core_begin = a;
@@ -198,7 +203,10 @@ class WindowFitter {
         consistent = LackOfFit(tw, zw, sigma, &window);
       }
     }
-    if (!consistent && may_split) return std::nullopt;
+    if (!consistent && may_split) {
+      if (missed != nullptr) *missed = true;
+      return std::nullopt;
+    }
     if (arbitrate) *undecided = true;
     window.verdict = (resolved || arbitrate) && consistent ? WindowVerdict::kResolved : WindowVerdict::kUnresolved;
     Finish(&window);
@@ -493,30 +501,44 @@ bool SplitPredictsBetter(const WindowFitter& fitter, const CurveWindow& window, 
   return halves.cwiseQuotient(held_out).mean() < 1.0;
 }
 
+// Whether some window of the segments is a piece of one split for missed motion.
+bool MissedMotion(const std::vector<CurveSegment>& segments) {
+  for (const CurveSegment& segment : segments) {
+    for (const CurveWindow& window : segment.windows) {
+      if (window.missed_motion) return true;
+    }
+  }
+  return false;
+}
+
 // Fits cores [a, b] of a segment adaptively: a core is halved until its series resolves or it
 // gets too small to split. Windows come out in time order.
 std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::VectorXd& t, const CurveSegment& segment,
                                      double a0, double b0, const CurveOptions& options) {
   std::vector<CurveWindow> windows;
-  std::vector<std::pair<double, double>> stack{{a0, b0}};
+  // Cores to fit, with whether they are pieces of a window split for missed motion.
+  std::vector<std::tuple<double, double, bool>> stack{{a0, b0, false}};
   while (!stack.empty()) {
-    const auto [a, b] = stack.back();
+    const auto [a, b, piece] = stack.back();
     stack.pop_back();
     const auto inside =
         std::upper_bound(t.data(), t.data() + t.size(), b) - std::lower_bound(t.data(), t.data() + t.size(), a);
     const bool may_split = inside >= 2 * options.min_window_samples;
     Eigen::VectorXd held_out;
-    bool undecided = false;
-    std::optional<CurveWindow> window = fitter.Fit(a, b, segment.begin, segment.end, may_split, &held_out, &undecided);
+    bool undecided = false, missed = false;
+    std::optional<CurveWindow> window =
+        fitter.Fit(a, b, segment.begin, segment.end, may_split, &held_out, &undecided, &missed);
     if (window && may_split && SplitPredictsBetter(fitter, *window, held_out, segment, options, undecided)) {
       window.reset();
+      missed = true;
     }
     if (!window) {
       const double middle = 0.5 * (a + b);
-      stack.emplace_back(middle, b);  // the left half is popped first: windows stay in time order
-      stack.emplace_back(a, middle);
+      stack.emplace_back(middle, b, piece || missed);  // the left half is popped first: windows stay in time order
+      stack.emplace_back(a, middle, piece || missed);
       continue;
     }
+    window->missed_motion = piece;
     windows.push_back(std::move(*window));
     if (options.progress) {  // the samples up to this window's end are fitted (windows come in time order)
       const auto done = std::upper_bound(t.data(), t.data() + t.size(), b) - t.data();
@@ -829,6 +851,25 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
       std::move(runs.begin(), runs.end(), std::back_inserter(curve.local_runs_));
     }
   }
+  // Where windows were split for missed motion, a local polynomial regression where it predicts
+  // the rate better (docs/velocity.md, "Local regression").
+  if (options.lack_of_fit && options.local_regression && adaptive && MissedMotion(curve.segments_)) {
+    Eigen::MatrixXd fit_values, fit_rates;
+    curve.EvaluateMany(sorted, 1, &fit_values, &fit_rates);
+    for (Eigen::Index i = 0; i < fitted_count; ++i) {  // the fitted values without the steps, as z
+      if (const Eigen::Index k = curve.StepsBefore(t[i]); k > 0) fit_values.row(i) -= curve.step_offsets_.row(k - 1);
+    }
+    std::vector<LocalRun> added;
+    for (size_t k = 0; k + 1 < starts.size(); ++k) {
+      std::vector<LocalRun> runs = internal::LocalRegressionRuns(t, z, starts[k], starts[k + 1], curve.segments_[k],
+                                                                 fit_values, fit_rates, curve.noise_sigma_,
+                                                                 curve.local_runs_);
+      std::move(runs.begin(), runs.end(), std::back_inserter(added));
+    }
+    std::move(added.begin(), added.end(), std::back_inserter(curve.local_runs_));
+    std::sort(curve.local_runs_.begin(), curve.local_runs_.end(),
+              [](const LocalRun& x, const LocalRun& y) { return x.times.front() < y.times.front(); });
+  }
 
   ReportProgress(options.progress, "fitting windows", fitted_count, fitted_count);
   // Residuals at every sample fitted.
@@ -1098,12 +1139,18 @@ std::string_view ToString(WindowVerdict verdict) {
 
 Eigen::Index Curve::local_samples() const {
   Eigen::Index count = 0;
-  for (const LocalRun& run : local_runs_) count += static_cast<Eigen::Index>(run.times.size());
+  for (const LocalRun& run : local_runs_) count += run.regression ? 0 : static_cast<Eigen::Index>(run.times.size());
+  return count;
+}
+
+Eigen::Index Curve::regression_samples() const {
+  Eigen::Index count = 0;
+  for (const LocalRun& run : local_runs_) count += run.regression ? static_cast<Eigen::Index>(run.times.size()) : 0;
   return count;
 }
 
 Eigen::Index Curve::stored_values() const {
-  Eigen::Index total = (2 * dimension_ + 1) * local_samples();  // a time, values and rates
+  Eigen::Index total = (2 * dimension_ + 1) * (local_samples() + regression_samples());  // a time, values and rates
   for (const CurveSegment& s : segments_) {
     for (const CurveWindow& w : s.windows) {
       for (int degree : w.degrees) total += degree + 1;
