@@ -21,9 +21,12 @@ namespace cheval::cheb::internal {
 /// pilot's own σ²|w_P|² is common to every candidate and cancels), and so are the windows' rates
 /// (their weights from each core window's normal matrix). The best candidate replaces the
 /// windows' rate in that coordinate when its score, plus twice the pilot's squared bias
-/// (estimated against degree 7 over 11 samples), is below the windows'. A run carries the
-/// regression's value and rate at the samples of the coordinates it replaces, the fit's
-/// elsewhere, and starts and ends on a sample of the fit.
+/// (estimated against degree 7 over 11 samples), is below the windows', its gain is at least 2
+/// standard errors (from the means of 53-sample blocks; stretches of at least 4 blocks), and the
+/// windows' rates differ from the pilot's by at least a quarter of what σ implies (else σ
+/// overstates the noise and the windows are kept; σ² itself is the smaller of the data's and
+/// what those differences imply). A run carries the regression's value and rate at the samples of the
+/// coordinates it replaces, the fit's elsewhere, and starts and ends on a sample of the fit.
 ///
 /// `t` (sorted, s) and `z` (m x d, steps taken out) are the curve's fitted samples, [first, last)
 /// the segment's, `fit_values` and `fit_rates` (m x d) the curve at them, `sigma` the noise per
