@@ -4,12 +4,14 @@
 #include "end_caps.h"
 #include "jumps.h"
 #include "local_rates.h"
+#include "local_regression.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -60,8 +62,14 @@ class WindowFitter {
   // window that may be split but whose coefficients cannot show it resolved while its residual is
   // consistent with the noise is returned (verdict resolved) with *undecided set: the caller
   // decides by prediction whether to split it (SplitPredictsBetter).
+  // With `missed`, a window that is not returned because its residual fails the lack-of-fit test
+  // sets *missed (it missed motion). With `reusable`, a window fitted without may_split tells
+  // whether the same call with may_split would return it unchanged (no subsample probe, no degree
+  // lowered for conditioning, coefficients and residual both resolved).
   std::optional<CurveWindow> Fit(double a, double b, double segment_begin, double segment_end, bool may_split,
-                                 Eigen::VectorXd* held_out = nullptr, bool* undecided = nullptr) const {
+                                 Eigen::VectorXd* held_out = nullptr, bool* undecided = nullptr,
+                                 bool* missed = nullptr, bool* reusable = nullptr) const {
+    if (reusable != nullptr) *reusable = false;
     const double extension = options_.overlap * (b - a);
     CurveWindow window;
     window.core_begin = a;
@@ -107,10 +115,9 @@ class WindowFitter {
     // recording) is usually split: a subsample with N²/m = 2 (well conditioned, coefficient noise
     // still white) tells that at a fraction of the cost. Only its "unresolved" is trusted: a
     // subsample's noise plateau is higher, so it resolves no less than all the samples would.
-    if (may_split) {
-      const Eigen::Index stride = m / std::max<Eigen::Index>(Eigen::Index{top} * top / 2, 16 * (top + 1));
-      if (stride >= 2 && !ResolvedOnSubsample(tw, zw, stride, top, interval)) return std::nullopt;
-    }
+    const Eigen::Index stride = m / std::max<Eigen::Index>(Eigen::Index{top} * top / 2, 16 * (top + 1));
+    if (may_split && stride >= 2 && !ResolvedOnSubsample(tw, zw, stride, top, interval)) return std::nullopt;
+    bool lowered = false;
     // Cross-validation needs the normal equations of each fold; their sum is the whole window's,
     // so the samples are visited once either way.
     const bool cross_validate = options_.degree_method == DegreeMethod::kCrossValidation;
@@ -142,6 +149,7 @@ class WindowFitter {
                                        window.fit_begin, window.fit_end, m));
       }
       top = std::max(1, static_cast<int>(0.7 * top));  // a leading block of the same normal equations
+      lowered = true;
     }
     const Eigen::MatrixXd high = cholesky->Solve(top, probe.rhs);
     window.coefficient_magnitudes = high.cwiseAbs();
@@ -198,8 +206,12 @@ class WindowFitter {
         consistent = LackOfFit(tw, zw, sigma, &window);
       }
     }
-    if (!consistent && may_split) return std::nullopt;
+    if (!consistent && may_split) {
+      if (missed != nullptr) *missed = true;
+      return std::nullopt;
+    }
     if (arbitrate) *undecided = true;
+    if (reusable != nullptr) *reusable = !may_split && stride < 2 && !lowered && resolved && consistent;
     window.verdict = (resolved || arbitrate) && consistent ? WindowVerdict::kResolved : WindowVerdict::kUnresolved;
     Finish(&window);
     return window;
@@ -478,19 +490,42 @@ class WindowFitter {
 // Its two halves are fitted too, and it is split when they predict held-out samples better: their
 // cross-validated squared error per sample, relative to the window's own and averaged over the
 // coordinates, is below 1 (no σ is involved).
+// A window fitted without splitting, its held-out errors, and whether FitAdaptive may take it as
+// the fit of its core (WindowFitter::Fit's `reusable`).
+struct HalfFit {
+  CurveWindow window;
+  Eigen::VectorXd held_out;
+  bool reusable = false;
+};
+
 bool SplitPredictsBetter(const WindowFitter& fitter, const CurveWindow& window, const Eigen::VectorXd& held_out,
-                         const CurveSegment& segment, const CurveOptions& options, bool undecided) {
+                         const CurveSegment& segment, const CurveOptions& options, bool undecided,
+                         std::array<std::optional<HalfFit>, 2>* halves) {
   if (options.degree_method != DegreeMethod::kCrossValidation || !options.lack_of_fit || held_out.size() == 0) {
     return false;
   }
   if (!(undecided || window.lack_of_fit.maxCoeff() > kSplitScore) || !(held_out.minCoeff() > 0.0)) return false;
   const double middle = 0.5 * (window.core_begin + window.core_end);
-  Eigen::VectorXd left_error, right_error;
-  const CurveWindow left = *fitter.Fit(window.core_begin, middle, segment.begin, segment.end, false, &left_error);
-  const CurveWindow right = *fitter.Fit(middle, window.core_end, segment.begin, segment.end, false, &right_error);
-  const double m_left = static_cast<double>(left.samples), m_right = static_cast<double>(right.samples);
-  const Eigen::VectorXd halves = (m_left * left_error + m_right * right_error) / (m_left + m_right);
-  return halves.cwiseQuotient(held_out).mean() < 1.0;
+  for (int k = 0; k < 2; ++k) {
+    HalfFit half;
+    half.window = *fitter.Fit(k == 0 ? window.core_begin : middle, k == 0 ? middle : window.core_end, segment.begin,
+                              segment.end, false, &half.held_out, nullptr, nullptr, &half.reusable);
+    (*halves)[static_cast<size_t>(k)] = std::move(half);
+  }
+  const HalfFit &left = *(*halves)[0], &right = *(*halves)[1];
+  const double m_left = static_cast<double>(left.window.samples), m_right = static_cast<double>(right.window.samples);
+  const Eigen::VectorXd error = (m_left * left.held_out + m_right * right.held_out) / (m_left + m_right);
+  return error.cwiseQuotient(held_out).mean() < 1.0;
+}
+
+// Whether some window of the segments is a piece of one split for missed motion.
+bool MissedMotion(const std::vector<CurveSegment>& segments) {
+  for (const CurveSegment& segment : segments) {
+    for (const CurveWindow& window : segment.windows) {
+      if (window.missed_motion) return true;
+    }
+  }
+  return false;
 }
 
 // Fits cores [a, b] of a segment adaptively: a core is halved until its series resolves or it
@@ -498,25 +533,40 @@ bool SplitPredictsBetter(const WindowFitter& fitter, const CurveWindow& window, 
 std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::VectorXd& t, const CurveSegment& segment,
                                      double a0, double b0, const CurveOptions& options) {
   std::vector<CurveWindow> windows;
-  std::vector<std::pair<double, double>> stack{{a0, b0}};
+  // Cores to fit, with whether they are pieces of a window split for missed motion and, when
+  // SplitPredictsBetter fitted them already, that fit.
+  std::vector<std::tuple<double, double, bool, std::optional<HalfFit>>> stack;
+  stack.emplace_back(a0, b0, false, std::nullopt);
   while (!stack.empty()) {
-    const auto [a, b] = stack.back();
+    auto [a, b, piece, fitted] = std::move(stack.back());
     stack.pop_back();
     const auto inside =
         std::upper_bound(t.data(), t.data() + t.size(), b) - std::lower_bound(t.data(), t.data() + t.size(), a);
     const bool may_split = inside >= 2 * options.min_window_samples;
     Eigen::VectorXd held_out;
-    bool undecided = false;
-    std::optional<CurveWindow> window = fitter.Fit(a, b, segment.begin, segment.end, may_split, &held_out, &undecided);
-    if (window && may_split && SplitPredictsBetter(fitter, *window, held_out, segment, options, undecided)) {
+    bool undecided = false, missed = false;
+    std::optional<CurveWindow> window;
+    // The fit SplitPredictsBetter made without splitting is this one when splitting is not
+    // allowed here either, or when it says the same call with splitting would return it.
+    if (fitted && (!may_split || fitted->reusable)) {
+      window = std::move(fitted->window);
+      held_out = std::move(fitted->held_out);
+    } else {
+      window = fitter.Fit(a, b, segment.begin, segment.end, may_split, &held_out, &undecided, &missed);
+    }
+    std::array<std::optional<HalfFit>, 2> halves;
+    if (window && may_split && SplitPredictsBetter(fitter, *window, held_out, segment, options, undecided, &halves)) {
       window.reset();
+      missed = true;
     }
     if (!window) {
       const double middle = 0.5 * (a + b);
-      stack.emplace_back(middle, b);  // the left half is popped first: windows stay in time order
-      stack.emplace_back(a, middle);
+      // The left half is popped first: windows stay in time order.
+      stack.emplace_back(middle, b, piece || missed, std::move(halves[1]));
+      stack.emplace_back(a, middle, piece || missed, std::move(halves[0]));
       continue;
     }
+    window->missed_motion = piece;
     windows.push_back(std::move(*window));
     if (options.progress) {  // the samples up to this window's end are fitted (windows come in time order)
       const auto done = std::upper_bound(t.data(), t.data() + t.size(), b) - t.data();
@@ -829,6 +879,25 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
       std::move(runs.begin(), runs.end(), std::back_inserter(curve.local_runs_));
     }
   }
+  // Where windows were split for missed motion, a local polynomial regression where it predicts
+  // the rate better (docs/velocity.md, "Local regression").
+  if (options.lack_of_fit && options.local_regression && adaptive && MissedMotion(curve.segments_)) {
+    Eigen::MatrixXd fit_values, fit_rates;
+    curve.EvaluateMany(sorted, 1, &fit_values, &fit_rates);
+    for (Eigen::Index i = 0; i < fitted_count; ++i) {  // the fitted values without the steps, as z
+      if (const Eigen::Index k = curve.StepsBefore(t[i]); k > 0) fit_values.row(i) -= curve.step_offsets_.row(k - 1);
+    }
+    std::vector<LocalRun> added;
+    for (size_t k = 0; k + 1 < starts.size(); ++k) {
+      std::vector<LocalRun> runs = internal::LocalRegressionRuns(t, z, starts[k], starts[k + 1], curve.segments_[k],
+                                                                 fit_values, fit_rates, curve.noise_sigma_,
+                                                                 curve.local_runs_);
+      std::move(runs.begin(), runs.end(), std::back_inserter(added));
+    }
+    std::move(added.begin(), added.end(), std::back_inserter(curve.local_runs_));
+    std::sort(curve.local_runs_.begin(), curve.local_runs_.end(),
+              [](const LocalRun& x, const LocalRun& y) { return x.times.front() < y.times.front(); });
+  }
 
   ReportProgress(options.progress, "fitting windows", fitted_count, fitted_count);
   // Residuals at every sample fitted.
@@ -1098,12 +1167,18 @@ std::string_view ToString(WindowVerdict verdict) {
 
 Eigen::Index Curve::local_samples() const {
   Eigen::Index count = 0;
-  for (const LocalRun& run : local_runs_) count += static_cast<Eigen::Index>(run.times.size());
+  for (const LocalRun& run : local_runs_) count += run.regression ? 0 : static_cast<Eigen::Index>(run.times.size());
+  return count;
+}
+
+Eigen::Index Curve::regression_samples() const {
+  Eigen::Index count = 0;
+  for (const LocalRun& run : local_runs_) count += run.regression ? static_cast<Eigen::Index>(run.times.size()) : 0;
   return count;
 }
 
 Eigen::Index Curve::stored_values() const {
-  Eigen::Index total = (2 * dimension_ + 1) * local_samples();  // a time, values and rates
+  Eigen::Index total = (2 * dimension_ + 1) * (local_samples() + regression_samples());  // a time, values and rates
   for (const CurveSegment& s : segments_) {
     for (const CurveWindow& w : s.windows) {
       for (int degree : w.degrees) total += degree + 1;

@@ -205,6 +205,8 @@ VelocityEstimate EstimateVelocity(const traj::TrajectoryView& trajectory, const 
     for (Eigen::Index i = 0; i < trajectory.size(); ++i) rotations[i] = trajectory.UnitQuaternion(i);
     RotationCurveOptions rotation_options;
     rotation_options.curve = options.curve;
+    // The charts' noise varies along them: a choice by one σ is not reliable there (docs/velocity.md).
+    rotation_options.curve.local_regression = false;
     RotationCurve rotation = FitRotationCurve(trajectory.stamps_ns(), rotations, rotation_options);
     rotation.EvaluateMany(query, &estimate.orientations, &estimate.angular_velocities);
     estimate.rotation_curve = std::move(rotation);
@@ -307,6 +309,7 @@ std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimat
     j["compression_ratio"] = static_cast<double>(3 * run.input_poses) / static_cast<double>(curve.stored_values());
     j["unresolved_windows"] = curve.unresolved_windows();
     j["local_samples"] = curve.local_samples();
+    j["regression_samples"] = curve.regression_samples();
     j["outliers"] = curve.outlier_times().size();
     j["jumps"] = curve.jump_times().size();
     j["steps"] = curve.step_times().size();

@@ -83,6 +83,12 @@ struct CurveOptions {
   /// judges by the coefficients alone (compression does: on nearly
   /// noise-free ground truth the residual test asks for windows that store more than the samples).
   bool lack_of_fit = true;
+  /// Where windows were split for missed motion (CurveWindow::missed_motion; not the end windows),
+  /// a local polynomial regression per coordinate takes over the rate when its velocity error,
+  /// estimated against a low-bias pilot, is below the windows' (docs/velocity.md, "Local
+  /// regression"). Needs `lack_of_fit` and an adaptive fit. The angular fit turns it off: the
+  /// charts' noise varies along them, and the choice relies on one σ.
+  bool local_regression = true;
   /// Told "fitting windows" with the samples fitted so far, as windows are accepted (may be empty).
   ProgressFn progress;
 
@@ -130,6 +136,9 @@ struct CurveWindow {
   /// normal score (Wilson–Hilferty), accepted up to 3 (diagnostics).
   Eigen::VectorXd lack_of_fit;
   WindowVerdict verdict = WindowVerdict::kResolved;
+  /// The window is a piece of a larger one that was split because it missed motion (its residual
+  /// failed the lack-of-fit test, or its halves predicted held-out samples better).
+  bool missed_motion = false;
 };
 
 /// A gap-free stretch of data with its windows, ordered in time.
@@ -149,6 +158,9 @@ struct LocalRun {
   std::vector<double> times;  ///< s from the curve's origin, increasing
   Eigen::MatrixXd values;     ///< (k x d), the curve's values without its steps
   Eigen::MatrixXd rates;      ///< (k x d), per second
+  /// The values and rates come from a local polynomial regression (CurveOptions::local_regression)
+  /// in the coordinates it replaced, not from the samples' own interpolant.
+  bool regression = false;
 };
 
 /// The fitted curve.
@@ -200,8 +212,10 @@ class Curve {
   /// Where the curve follows the samples instead of the windows (CurveOptions::lack_of_fit), in
   /// time order; empty when every window resolved the motion.
   const std::vector<LocalRun>& local_runs() const { return local_runs_; }
-  /// The samples in local_runs (each run's ends included).
+  /// The samples in local_runs of the samples' own interpolant (each run's ends included).
   Eigen::Index local_samples() const;
+  /// The samples in local_runs of the local polynomial regression (each run's ends included).
+  Eigen::Index regression_samples() const;
 
  private:
   // Where a time falls: its window, and when it is in a blending zone the next window with the

@@ -1,0 +1,416 @@
+#include "local_regression.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Cholesky>
+
+#include "cheval/cheb/fit.h"
+#include "cheval/common/error.h"
+
+namespace cheval::cheb::internal {
+namespace {
+
+// Half-widths (samples on either side) of the candidate regressions: 7 to 53 samples.
+constexpr std::array<int, 12> kHalves{3, 4, 5, 6, 7, 9, 11, 13, 16, 19, 22, 26};
+constexpr int kMaxDegree = 7;
+// The pilot (degree 7 over 15 samples: little bias) and the narrower fit its bias is judged against.
+constexpr int kPilotHalf = 7, kBiasHalf = 5;
+// A regression needs this many samples more than its coefficients.
+constexpr int kSpareSamples = 3;
+// A candidate replaces the windows only when its estimated gain is this many standard errors.
+constexpr double kSignificance = 2.0;
+// Samples per block of the gains' standard error: the widest candidate's.
+constexpr Eigen::Index kBlock = 53;
+// Shorter stretches are left to the windows: fewer than 4 blocks say little about the scatter.
+constexpr Eigen::Index kMinStretch = 4 * kBlock;
+// Windows whose rates differ from the pilot's by less than this fraction of the noise variance
+// that σ implies are left alone (σ overstates the noise there).
+constexpr double kSmoothFraction = 0.25;
+
+using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxDegree + 1, kMaxDegree + 1>;
+using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDegree + 1, 1>;
+
+// One regression at one sample: value and rate per coordinate, and the rate's weights on the
+// samples [lo, hi] as a polynomial g in x = (t − t_i)/scale: w_j = g(x_j)/scale.
+struct Regression {
+  Eigen::Index lo = 0, hi = -1;
+  double scale = 1.0;
+  SmallVector weights;
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 4, 1> value, rate;
+  bool ok = false;
+
+  double Weight(double t, double ti) const {
+    const double x = (t - ti) / scale;
+    double g = 0.0;
+    for (Eigen::Index k = weights.size() - 1; k >= 0; --k) g = g * x + weights[k];
+    return g / scale;
+  }
+};
+
+// The regressions of every half-width of kHalves at sample i of a segment's samples (t, z: its
+// rows), from power sums accumulated as the (nested) windows grow.
+class LocalFits {
+ public:
+  LocalFits(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z, Eigen::Index i)
+      : t_(t), z_(z), i_(i) {
+    const Eigen::Index d = z.cols();
+    Eigen::Index lo = i, hi = i - 1;
+    const auto [lo_max, hi_max] = Bounds(kHalves.back());
+    unit_ = std::max({t[hi_max] - t[i], t[i] - t[lo_max], 1e-300});
+    Eigen::Matrix<double, 2 * kMaxDegree + 1, 1> powers = Eigen::Matrix<double, 2 * kMaxDegree + 1, 1>::Zero();
+    Eigen::Matrix<double, kMaxDegree + 1, Eigen::Dynamic> moments = Eigen::MatrixXd::Zero(kMaxDegree + 1, d);
+    auto add = [&](Eigen::Index j) {
+      const double u = (t[j] - t[i]) / unit_;
+      double p = 1.0;
+      for (int q = 0; q <= 2 * kMaxDegree; ++q, p *= u) {
+        powers[q] += p;
+        if (q <= kMaxDegree) moments.row(q) += p * z.row(j);
+      }
+    };
+    for (size_t h = 0; h < kHalves.size(); ++h) {
+      const auto [a, b] = Bounds(kHalves[h]);
+      for (Eigen::Index j = a; j < lo; ++j) add(j);
+      for (Eigen::Index j = std::max(hi + 1, a); j <= b; ++j) add(j);
+      lo = std::min(lo, a);
+      hi = std::max(hi, b);
+      lo_[h] = lo, hi_[h] = hi;
+      powers_[h] = powers;
+      moments_[h] = moments;
+    }
+  }
+
+  // The window [lo, hi] of half-width `half` at sample i, shifted to stay inside the samples.
+  std::pair<Eigen::Index, Eigen::Index> Bounds(int half) const {
+    const Eigen::Index n = t_.size();
+    if (2 * half + 1 >= n) return {0, n - 1};
+    const Eigen::Index lo = std::clamp<Eigen::Index>(i_ - half, 0, n - 1 - 2 * half);
+    return {lo, lo + 2 * half};
+  }
+
+  // The regression of degree `degree` over half-width kHalves[h].
+  Regression Fit(size_t h, int degree) const {
+    Regression r;
+    r.lo = lo_[h], r.hi = hi_[h];
+    if (r.hi - r.lo + 1 < degree + 1 + kSpareSamples) return r;
+    const double ti = t_[i_];
+    r.scale = std::max(t_[r.hi] - ti, ti - t_[r.lo]);
+    if (!(r.scale > 0.0)) return r;
+    const double ratio = unit_ / r.scale;  // x = u·ratio
+    const int n = degree + 1;
+    SmallVector ratio_powers(2 * kMaxDegree + 1);
+    ratio_powers[0] = 1.0;
+    for (int q = 1; q <= 2 * degree; ++q) ratio_powers[q] = ratio_powers[q - 1] * ratio;
+    Small gram(n, n);
+    for (int k = 0; k < n; ++k) {
+      for (int l = 0; l < n; ++l) gram(k, l) = powers_[h][k + l] * ratio_powers[k + l];
+    }
+    const Eigen::LDLT<Small> ldlt(gram);
+    if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-14)) return r;
+    SmallVector unit = SmallVector::Zero(n);
+    unit[1] = 1.0;
+    r.weights = ldlt.solve(unit);
+    const Eigen::Index d = z_.cols();
+    r.value.resize(d);
+    r.rate.resize(d);
+    for (Eigen::Index c = 0; c < d; ++c) {
+      SmallVector rhs(n);
+      for (int k = 0; k < n; ++k) rhs[k] = moments_[h](k, c) * ratio_powers[k];
+      // value = e0ᵀG⁻¹b, rate = e1ᵀG⁻¹b/scale = gᵀb/scale.
+      const SmallVector coefficients = ldlt.solve(rhs);
+      r.value[c] = coefficients[0];
+      r.rate[c] = coefficients[1] / r.scale;
+    }
+    r.ok = true;
+    return r;
+  }
+
+ private:
+  Eigen::Ref<const Eigen::VectorXd> t_;
+  Eigen::Ref<const Eigen::MatrixXd> z_;
+  Eigen::Index i_;
+  double unit_ = 1.0;
+  std::array<Eigen::Index, kHalves.size()> lo_{}, hi_{};
+  std::array<Eigen::Matrix<double, 2 * kMaxDegree + 1, 1>, kHalves.size()> powers_;
+  std::array<Eigen::Matrix<double, kMaxDegree + 1, Eigen::Dynamic>, kHalves.size()> moments_;
+};
+
+// Σ_j w_a(j)·w_b(j) over the samples both regressions use.
+double WeightProduct(const Eigen::Ref<const Eigen::VectorXd>& t, double ti, const Regression& a, const Regression& b) {
+  double sum = 0.0;
+  for (Eigen::Index j = std::max(a.lo, b.lo); j <= std::min(a.hi, b.hi); ++j) sum += a.Weight(t[j], ti) * b.Weight(t[j], ti);
+  return sum;
+}
+
+// |w|² of a regression's rate: (G⁻¹)_11/scale², i.e. g_1/scale².
+double WeightNorm(const Regression& r) { return r.weights[1] / (r.scale * r.scale); }
+
+// The candidates: (half-width index, degree) with degree odd 1..7.
+std::vector<std::pair<size_t, int>> Candidates() {
+  std::vector<std::pair<size_t, int>> candidates;
+  for (size_t h = 0; h < kHalves.size(); ++h) {
+    for (int degree = 1; degree <= kMaxDegree; degree += 2) {
+      if (2 * kHalves[h] + 1 >= degree + 1 + kSpareSamples) candidates.emplace_back(h, degree);
+    }
+  }
+  return candidates;
+}
+
+size_t HalfIndex(int half) {
+  return static_cast<size_t>(std::find(kHalves.begin(), kHalves.end(), half) - kHalves.begin());
+}
+
+// The covariance factor of a window's rate with the pilot's at sample i: w_W·w_P, with w_W(j) =
+// s·T'(x_i)ᵀ G⁻¹ T(x_j) from the window's normal matrix (per coordinate degree).
+class WindowWeights {
+ public:
+  WindowWeights(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const CurveWindow& window) : window_(window) {
+    const auto first = std::lower_bound(t.data(), t.data() + t.size(), window.fit_begin) - t.data();
+    const auto last = std::upper_bound(t.data(), t.data() + t.size(), window.fit_end) - t.data();
+    top_ = *std::max_element(window.degrees.begin(), window.degrees.end());
+    if (top_ < 1) return;
+    try {
+      const NormalEquations normal =
+          BuildNormalEquations(t.segment(first, last - first), z.middleRows(first, last - first), top_, window.series.interval);
+      cholesky_.emplace(normal, top_);
+    } catch (const ComputeError&) {
+      cholesky_.reset();
+    }
+  }
+
+  // w_W·w_P per coordinate at time ti for the pilot `pilot` (on the segment's samples `ts`), and
+  // |w_W|² into `norm`.
+  Eigen::VectorXd Product(const Eigen::Ref<const Eigen::VectorXd>& ts, double ti, const Regression& pilot,
+                          Eigen::VectorXd* norm) const {
+    const auto d = static_cast<Eigen::Index>(window_.degrees.size());
+    Eigen::VectorXd product = Eigen::VectorXd::Zero(d);
+    norm->setZero(d);
+    if (!cholesky_) return product;
+    const Interval& interval = window_.series.interval;
+    // u = Σ_j w_P(j) T(x_j), and T'(x_i) = k·U_{k−1}(x_i).
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(top_ + 1), derivative(top_ + 1);
+    for (Eigen::Index j = pilot.lo; j <= pilot.hi; ++j) {
+      if (ts[j] < window_.fit_begin || ts[j] > window_.fit_end) continue;  // not the window's sample
+      const double x = interval.ToUnit(ts[j]), w = pilot.Weight(ts[j], ti);
+      double previous = 1.0, current = x;
+      u[0] += w;
+      if (top_ >= 1) u[1] += w * x;
+      for (int k = 2; k <= top_; ++k) {
+        const double next = 2.0 * x * current - previous;
+        previous = current, current = next;
+        u[k] += w * current;
+      }
+    }
+    const double x = interval.ToUnit(ti);
+    double u_previous = 0.0, u_current = 1.0;  // U_{-1}, U_0
+    derivative[0] = 0.0;
+    for (int k = 1; k <= top_; ++k) {
+      derivative[k] = k * u_current;
+      const double next = 2.0 * x * u_current - u_previous;
+      u_previous = u_current, u_current = next;
+    }
+    derivative *= interval.DerivativeScale();
+    for (Eigen::Index c = 0; c < d; ++c) {
+      const int degree = window_.degrees[static_cast<size_t>(c)];
+      if (degree < 1) continue;
+      product[c] = derivative.head(degree + 1).dot(cholesky_->Solve(degree, u).col(0));
+      (*norm)[c] = derivative.head(degree + 1).dot(cholesky_->Solve(degree, derivative).col(0));
+    }
+    return product;
+  }
+
+ private:
+  const CurveWindow& window_;
+  int top_ = 0;
+  std::optional<NestedCholesky> cholesky_;
+};
+
+// Sums over a stretch of samples for choosing between the candidates and the windows: squared
+// rate differences from the pilot and weight products with it, per candidate (rows) and
+// coordinate; the same for the windows; the pilot's bias against the reference; and the
+// per-sample gains over the windows, D = (v_a − v_P)² − (v_W − v_P)² and P = w_a·w_P − w_W·w_P,
+// summed per block of kBlock samples (the gains are correlated over about a candidate's width;
+// the blocks' means scatter like independent draws).
+struct StretchScores {
+  StretchScores(Eigen::Index count, Eigen::Index d, Eigen::Index samples)
+      : length(samples),
+        blocks(samples / kBlock),
+        differences(Eigen::MatrixXd::Zero(count, d)),
+        products(Eigen::VectorXd::Zero(count)),
+        window_differences(Eigen::VectorXd::Zero(d)),
+        window_products(Eigen::VectorXd::Zero(d)),
+        window_spread(Eigen::VectorXd::Zero(d)),
+        bias_differences(Eigen::VectorXd::Zero(d)),
+        usable(static_cast<size_t>(count), 1),
+        block_gains(static_cast<size_t>(blocks), Eigen::MatrixXd::Zero(count, d)),
+        block_products(static_cast<size_t>(blocks), Eigen::MatrixXd::Zero(count, d)) {}
+
+  // The candidate that replaces the windows in coordinate c (noise σ), or -1.
+  int Choose(Eigen::Index c, double sigma) const {
+    // The windows' rates differ from the pilot's by at least their noise, σ²·Σ|w_W − w_P|² in
+    // expectation: where they differ less, σ overstates the noise there (motion taken for noise,
+    // e.g. a noise-free tremor), and the smaller value follows from the differences.
+    const double data_variance = sigma * sigma;
+    const double variance = std::min(
+        data_variance, window_spread[c] > 0.0 ? window_differences[c] / window_spread[c] : data_variance);
+    // Windows closer to the pilot than a fraction of that: nothing here tells the pilot's bias
+    // from noise, and the windows are kept.
+    if (variance < kSmoothFraction * data_variance) return -1;
+    int chosen = -1;
+    double best = std::numeric_limits<double>::infinity();
+    for (Eigen::Index a = 0; a < differences.rows(); ++a) {
+      const double score = differences(a, c) + 2.0 * variance * products[a];
+      if (usable[static_cast<size_t>(a)] && score < best) {
+        best = score;
+        chosen = static_cast<int>(a);
+      }
+    }
+    const double bias = std::max(0.0, bias_differences[c] - variance * bias_variance);
+    const double windows_score = window_differences[c] + 2.0 * variance * window_products[c];
+    if (chosen < 0 || !(best + 2.0 * bias < windows_score)) return -1;
+    // The gain must stand out of its own scatter: 2 standard errors of the mean of the blocks'.
+    double sum = 0.0, sum_squares = 0.0;
+    for (size_t b = 0; b < block_gains.size(); ++b) {
+      const double size = b + 1 == block_gains.size() ? static_cast<double>(length - static_cast<Eigen::Index>(b) * kBlock)
+                                                      : static_cast<double>(kBlock);
+      const double gain = (block_gains[b](chosen, c) + 2.0 * variance * block_products[b](chosen, c)) / size;
+      sum += gain * size, sum_squares += gain * gain;
+    }
+    const double mean = sum / static_cast<double>(length), count = static_cast<double>(blocks);
+    const double error = std::sqrt(std::max(0.0, sum_squares / count - mean * mean) / (count - 1.0));
+    return mean < -kSignificance * error ? chosen : -1;
+  }
+
+  Eigen::Index length, blocks;
+  Eigen::MatrixXd differences;
+  Eigen::VectorXd products, window_differences, window_products, window_spread, bias_differences;
+  double bias_variance = 0.0;
+  std::vector<char> usable;
+  std::vector<Eigen::MatrixXd> block_gains, block_products;
+};
+
+}  // namespace
+
+std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
+                                          Eigen::Index last, const CurveSegment& segment,
+                                          const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
+                                          const Eigen::VectorXd& sigma, const std::vector<LocalRun>& taken) {
+  std::vector<LocalRun> runs;
+  const std::vector<CurveWindow>& windows = segment.windows;
+  const Eigen::Index n = last - first, d = z.cols();
+  if (windows.size() < 3 || n < 2 * kHalves.back() + 1) return runs;
+  // Candidate samples and the window whose core holds each.
+  std::vector<int> owner(static_cast<size_t>(n), -1);
+  bool any = false;
+  size_t w = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double ti = t[first + i];
+    while (w + 1 < windows.size() && ti >= windows[w + 1].core_begin) ++w;
+    if (w == 0 || w + 1 == windows.size() || !windows[w].missed_motion) continue;
+    const bool inside = std::any_of(taken.begin(), taken.end(), [ti](const LocalRun& run) {
+      return ti >= run.times.front() && ti <= run.times.back();
+    });
+    if (inside) continue;
+    owner[static_cast<size_t>(i)] = static_cast<int>(w);
+    any = true;
+  }
+  if (!any) return runs;
+
+  const auto ts = t.segment(first, n);
+  const auto zs = z.middleRows(first, n);
+  const std::vector<std::pair<size_t, int>> candidates = Candidates();
+  const auto count = static_cast<Eigen::Index>(candidates.size());
+  const size_t pilot_h = HalfIndex(kPilotHalf), bias_h = HalfIndex(kBiasHalf);
+  std::vector<std::optional<WindowWeights>> window_weights(windows.size());
+
+  for (Eigen::Index s0 = 0; s0 < n;) {
+    if (owner[static_cast<size_t>(s0)] < 0) {
+      ++s0;
+      continue;
+    }
+    Eigen::Index s1 = s0;
+    while (s1 < n && owner[static_cast<size_t>(s1)] >= 0) ++s1;
+    const Eigen::Index length = s1 - s0;
+    if (length < kMinStretch) {
+      s0 = s1;
+      continue;
+    }
+    StretchScores scores(count, d, length);
+    Eigen::VectorXd norm(d);
+    for (Eigen::Index i = s0; i < s1; ++i) {
+      const LocalFits fits(ts, zs, i);
+      const Regression pilot = fits.Fit(pilot_h, kMaxDegree);
+      const Regression reference = fits.Fit(bias_h, kMaxDegree);
+      if (!pilot.ok || !reference.ok) return runs;
+      const double ti = ts[i];
+      scores.bias_differences += (pilot.rate - reference.rate).cwiseAbs2();
+      scores.bias_variance += WeightNorm(pilot) - 2.0 * WeightProduct(ts, ti, pilot, reference) + WeightNorm(reference);
+      const auto k = static_cast<size_t>(owner[static_cast<size_t>(i)]);
+      if (!window_weights[k]) window_weights[k].emplace(t, z, windows[k]);
+      const Eigen::VectorXd window_difference = (fit_rates.row(first + i).transpose() - pilot.rate).cwiseAbs2();
+      const Eigen::VectorXd product = window_weights[k]->Product(ts, ti, pilot, &norm);
+      scores.window_differences += window_difference;
+      scores.window_products += product;
+      scores.window_spread += ((norm - 2.0 * product).array() + WeightNorm(pilot)).matrix();
+      const auto block = static_cast<size_t>(std::min(scores.blocks - 1, (i - s0) / kBlock));
+      for (Eigen::Index a = 0; a < count; ++a) {
+        const auto [h, degree] = candidates[static_cast<size_t>(a)];
+        const Regression r = fits.Fit(h, degree);
+        if (!r.ok) {
+          scores.usable[static_cast<size_t>(a)] = 0;
+          continue;
+        }
+        const Eigen::VectorXd difference = (r.rate - pilot.rate).cwiseAbs2();
+        const double weight_product = WeightProduct(ts, ti, r, pilot);
+        scores.differences.row(a) += difference.transpose();
+        scores.products[a] += weight_product;
+        scores.block_gains[block].row(a) += (difference - window_difference).transpose();
+        scores.block_products[block].row(a) += (weight_product - product.array()).matrix().transpose();
+      }
+    }
+    std::vector<int> chosen(static_cast<size_t>(d), -1);
+    bool replaced = false;
+    for (Eigen::Index c = 0; c < d; ++c) {
+      chosen[static_cast<size_t>(c)] = scores.Choose(c, sigma[c]);
+      replaced = replaced || chosen[static_cast<size_t>(c)] >= 0;
+    }
+    if (replaced) {
+      // The run: the stretch and a sample of the fit on either side.
+      const Eigen::Index begin = std::max<Eigen::Index>(0, s0 - 1), stop = std::min(n, s1 + 1);
+      LocalRun run;
+      run.regression = true;
+      run.values.resize(stop - begin, d);
+      run.rates.resize(stop - begin, d);
+      for (Eigen::Index i = begin; i < stop; ++i) {
+        if (!run.times.empty() && !(ts[i] > run.times.back())) continue;
+        const auto r = static_cast<Eigen::Index>(run.times.size());
+        run.times.push_back(ts[i]);
+        run.values.row(r) = fit_values.row(first + i);
+        run.rates.row(r) = fit_rates.row(first + i);
+        if (i < s0 || i >= s1) continue;
+        const LocalFits fits(ts, zs, i);
+        for (Eigen::Index c = 0; c < d; ++c) {
+          const int a = chosen[static_cast<size_t>(c)];
+          if (a < 0) continue;
+          const auto [h, degree] = candidates[static_cast<size_t>(a)];
+          const Regression fit = fits.Fit(h, degree);
+          run.values(r, c) = fit.value[c];
+          run.rates(r, c) = fit.rate[c];
+        }
+      }
+      if (run.times.size() >= 2) {
+        run.values.conservativeResize(static_cast<Eigen::Index>(run.times.size()), d);
+        run.rates.conservativeResize(static_cast<Eigen::Index>(run.times.size()), d);
+        runs.push_back(std::move(run));
+      }
+    }
+    s0 = s1;
+  }
+  return runs;
+}
+
+}  // namespace cheval::cheb::internal

@@ -1,0 +1,39 @@
+#pragma once
+// Internal to the cheb library: where windows were split for missed motion, a local polynomial
+// regression may take over the rate (src/cheb/local_regression.cc; docs/velocity.md, "Local
+// regression").
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "cheval/cheb/curve.h"
+
+namespace cheval::cheb::internal {
+
+/// The local-regression runs of one segment. Candidates are stretches of consecutive samples in
+/// the cores of windows split for missed motion (CurveWindow::missed_motion), the segment's first
+/// and last window left out (the end caps' variance is not the window's) and samples inside
+/// `taken` (runs already made) too. Per stretch and coordinate, each local polynomial regression
+/// of odd degree 1–7 over 7–53 samples centred on each sample (shifted to stay inside the
+/// segment) is scored by its velocity error estimated against a pilot of little bias (degree 7
+/// over 15 samples), mean (v_a − v_P)² + 2σ²·w_a·w_P (w the rate's weights on the samples; the
+/// pilot's own σ²|w_P|² is common to every candidate and cancels), and so are the windows' rates
+/// (their weights from each core window's normal matrix). The best candidate replaces the
+/// windows' rate in that coordinate when its score, plus twice the pilot's squared bias
+/// (estimated against degree 7 over 11 samples), is below the windows', its gain is at least 2
+/// standard errors (from the means of 53-sample blocks; stretches of at least 4 blocks), and the
+/// windows' rates differ from the pilot's by at least a quarter of what σ implies (else σ
+/// overstates the noise and the windows are kept; σ² itself is the smaller of the data's and
+/// what those differences imply). A run carries the regression's value and rate at the samples of the
+/// coordinates it replaces, the fit's elsewhere, and starts and ends on a sample of the fit.
+///
+/// `t` (sorted, s) and `z` (m x d, steps taken out) are the curve's fitted samples, [first, last)
+/// the segment's, `fit_values` and `fit_rates` (m x d) the curve at them, `sigma` the noise per
+/// coordinate.
+std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
+                                          Eigen::Index last, const CurveSegment& segment,
+                                          const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
+                                          const Eigen::VectorXd& sigma, const std::vector<LocalRun>& taken);
+
+}  // namespace cheval::cheb::internal
