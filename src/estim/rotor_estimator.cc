@@ -493,9 +493,9 @@ RotorVehicle IdentifyRotors(const std::vector<RotorFlight>& flights, const Rotor
   if (per_flight) per_flight->insert(per_flight->end(), each.begin(), each.end());
   const RotorIdentification combined = CombineIdentifications(all);
   out.theta = combined.theta;
-  // Between flights: a flight's pieces may agree with each other and not with another flight's (the
-  // battery seated elsewhere moves τ0); σ is widened by the flights' own Birge ratio too, each flight
-  // with its σ from its own pieces.
+  // Between flights: a flight's pieces may agree with each other and not with another flight's (τ0,
+  // k_m1 and d_xy of square against the other two, docs/estimator_real_data.md); σ is widened by the
+  // flights' own Birge ratio too, each flight with its σ from its own pieces.
   out.theta_sigma = combined.covariance.diagonal().cwiseSqrt().cwiseProduct(BirgeRatios(each, combined.theta));
   return out;
 }
