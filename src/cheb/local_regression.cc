@@ -102,7 +102,7 @@ class LocalFits {
     if (!(r.scale > 0.0)) return r;
     const double ratio = unit_ / r.scale;  // x = u·ratio
     const int n = degree + 1;
-    SmallVector ratio_powers(2 * kMaxDegree + 1);
+    std::array<double, 2 * kMaxDegree + 1> ratio_powers{};  // up to 2·degree: more than a SmallVector holds
     ratio_powers[0] = 1.0;
     for (int q = 1; q <= 2 * degree; ++q) ratio_powers[q] = ratio_powers[q - 1] * ratio;
     Small gram(n, n);
