@@ -261,10 +261,7 @@ class PseudoSpectralProblem {
                        const std::vector<int>& used_blocks, const ceres::LossFunction* loss = nullptr,
                        bool uses_rotation = true) {
     using Cost = internal::MeasurementCost<Model, F>;
-    if (times.size() != functors.size()) throw UsageError("AddMeasurements: one functor per time");
-    for (auto& [s, rows_of] : RowsBySegment(times)) {
-      std::vector<typename Cost::Sample> samples;
-      for (auto& [i, row] : rows_of) samples.push_back({std::move(row), std::move(functors[i])});
+    for (auto& [s, samples] : SamplesBySegment<typename Cost::Sample>(times, std::move(functors), "AddMeasurements")) {
       auto cost = std::make_unique<Cost>(SegmentOf(s), std::move(samples), rows, group_rows, used_blocks, loss,
                                          uses_rotation);
       ceres::LossFunction* ceres_loss = cost->ceres_loss();
@@ -286,11 +283,9 @@ class PseudoSpectralProblem {
   void AddDelayedPositions(const std::vector<double>& times, const std::vector<Eigen::Vector3d>& measured,
                            int position_block, int velocity_block, double sigma, const ceres::LossFunction* loss,
                            double* delay) {
-    if (times.size() != measured.size()) throw UsageError("AddDelayedPositions: one position per time");
     if (Model::kBlockSize != 3) throw UsageError("AddDelayedPositions: the model's vector blocks must be of 3");
-    for (auto& [s, rows_of] : RowsBySegment(times)) {
-      std::vector<internal::DelayedPositionCost::Sample> samples;
-      for (auto& [i, row] : rows_of) samples.push_back({std::move(row), measured[i]});
+    for (auto& [s, samples] :
+         SamplesBySegment<internal::DelayedPositionCost::Sample>(times, measured, "AddDelayedPositions")) {
       Add(std::make_unique<internal::DelayedPositionCost>(SegmentOf(s), std::move(samples), position_block,
                                                           velocity_block, sigma, loss, delay));
     }
@@ -316,10 +311,8 @@ class PseudoSpectralProblem {
   void AddDerivativeMeasurements(const std::vector<double>& times, std::vector<F> functors, int rows, int group_rows,
                                  const std::vector<int>& used_blocks, const ceres::LossFunction* loss = nullptr) {
     using Cost = internal::DerivativeMeasurementCost<Model, F>;
-    if (times.size() != functors.size()) throw UsageError("AddDerivativeMeasurements: one functor per time");
-    for (auto& [s, rows_of] : RowsBySegment(times)) {
-      std::vector<typename Cost::Sample> samples;
-      for (auto& [i, row] : rows_of) samples.push_back({std::move(row), std::move(functors[i])});
+    for (auto& [s, samples] :
+         SamplesBySegment<typename Cost::Sample>(times, std::move(functors), "AddDerivativeMeasurements")) {
       auto cost = std::make_unique<Cost>(SegmentOf(s), std::move(samples), rows, group_rows, used_blocks, loss);
       ceres::LossFunction* ceres_loss = cost->ceres_loss();
       Add(std::move(cost), ceres_loss);
@@ -481,13 +474,17 @@ class PseudoSpectralProblem {
     return problem_->AddResidualBlock(cost.release(), loss, blocks);
   }
 
-  // The indices of `times` by the segment of their time, each with its rows (in the order given).
-  std::map<int, std::vector<std::pair<size_t, internal::TimeRow>>> RowsBySegment(const std::vector<double>& times) const {
-    std::map<int, std::vector<std::pair<size_t, internal::TimeRow>>> out;
+  // The batches of a batched cost: per segment, a Sample {row, item} for each time in it (in the order
+  // given). UsageError, naming `caller`, when there is not one item per time.
+  template <class Sample, class Item>
+  std::map<int, std::vector<Sample>> SamplesBySegment(const std::vector<double>& times, std::vector<Item> items,
+                                                     const char* caller) const {
+    if (times.size() != items.size()) throw UsageError(fmt::format("{}: one measurement per time", caller));
+    std::map<int, std::vector<Sample>> out;
     for (size_t i = 0; i < times.size(); ++i) {
       internal::TimeRow row = RowAt(times[i]);
       const int s = row.segment;
-      out[s].emplace_back(i, std::move(row));
+      out[s].push_back({std::move(row), std::move(items[i])});
     }
     return out;
   }

@@ -70,14 +70,7 @@ class DerivativeMeasurementCost : public BlockCost {
     const int N = static_cast<int>(storage_.size()) - 1;
     const int used = static_cast<int>(used_.size());
     std::vector<Vector> nodes(N + 1);
-    for (int k = 0; k <= N; ++k) {
-      for (int b = 0; b < kBlocks; ++b) {
-        const auto it = std::find(used_.begin(), used_.end(), b);
-        const double* src = it == used_.end() ? storage_[k] + b * kBlock
-                                              : parameters[k * used + static_cast<int>(it - used_.begin())];
-        nodes[k].segment(b * kBlock, kBlock) = Eigen::Map<const Eigen::Matrix<double, kBlock, 1>>(src);
-      }
-    }
+    for (int k = 0; k <= N; ++k) nodes[k] = NodeVector<Model>(storage_, used_, parameters, k, used);
     const auto derivative = [&](const TimeRow& row) {
       Vector x_dot = Vector::Zero();
       for (int k = 0; k <= N; ++k) x_dot += row.dw[k] * nodes[k];

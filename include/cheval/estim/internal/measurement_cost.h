@@ -88,12 +88,7 @@ class MeasurementCost : public BlockCost {
     std::vector<Vector> nodes(N + 1);
     std::vector<Eigen::Vector3d> phis(rotation_ ? N + 1 : 0);
     for (int k = 0; k <= N; ++k) {
-      for (int b = 0; b < kBlocks; ++b) {
-        const auto it = std::find(used_.begin(), used_.end(), b);
-        const double* src = it == used_.end() ? storage_[k] + b * kBlock
-                                              : parameters[k * per_node + static_cast<int>(it - used_.begin())];
-        nodes[k].segment(b * kBlock, kBlock) = Eigen::Map<const Eigen::Matrix<double, kBlock, 1>>(src);
-      }
+      nodes[k] = NodeVector<Model>(storage_, used_, parameters, k, per_node);
       if (rotation_) phis[k] = ChartVector(reference_, parameters[k * per_node + per_node - 1]);
     }
     const int total_rows = rows_ * static_cast<int>(samples_.size());

@@ -8,6 +8,7 @@
 /// Point order: the N + 1 nodes of a segment are numbered k = 0..N in descending Chebyshev order
 /// (k = 0 is the segment's end), as the rows of cheb::ChebyshevBasis.
 
+#include <algorithm>
 #include <vector>
 
 #include <Eigen/Core>
@@ -56,6 +57,24 @@ struct Segment {
   std::vector<double*> vector, quaternion, control;  ///< per point k = 0..N
   int degree() const { return static_cast<int>(vector.size()) - 1; }
 };
+
+/// The vector part of node k (point order) for a cost that reads only some vector blocks: the blocks in
+/// `used` from Evaluate's `parameters` (`per_node` blocks per node, the used ones first, in the order
+/// of `used`), the others from the problem's `storage` (held).
+template <class Model>
+Eigen::Matrix<double, Dims<Model>::kVector, 1> NodeVector(const std::vector<double*>& storage,
+                                                        const std::vector<int>& used,
+                                                        double const* const* parameters, int k, int per_node) {
+  constexpr int kBlock = Dims<Model>::kBlock;
+  Eigen::Matrix<double, Dims<Model>::kVector, 1> x;
+  for (int b = 0; b < Dims<Model>::kBlocks; ++b) {
+    const auto it = std::find(used.begin(), used.end(), b);
+    const double* src =
+        it == used.end() ? storage[k] + b * kBlock : parameters[k * per_node + static_cast<int>(it - used.begin())];
+    x.template segment<kBlock>(b * kBlock) = Eigen::Map<const Eigen::Matrix<double, kBlock, 1>>(src);
+  }
+  return x;
+}
 
 /// φ_k and J_r⁻¹(φ_k) of the rotations of a segment's nodes (k = 0..N) in its chart.
 struct Charts {
