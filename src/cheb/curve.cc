@@ -70,25 +70,21 @@ class WindowFitter {
                                  Eigen::VectorXd* held_out = nullptr, bool* undecided = nullptr,
                                  bool* missed = nullptr, bool* reusable = nullptr) const {
     if (reusable != nullptr) *reusable = false;
-    const double extension = options_.overlap * (b - a);
+    const Span span = Samples(a, b, segment_begin, segment_end);
     CurveWindow window;
     window.core_begin = a;
     window.core_end = b;
-    window.fit_begin = std::max(a - extension, segment_begin);
-    window.fit_end = std::min(b + extension, segment_end);
-    const auto first = std::lower_bound(t_.data(), t_.data() + t_.size(), window.fit_begin) - t_.data();
-    const auto last = std::upper_bound(t_.data(), t_.data() + t_.size(), window.fit_end) - t_.data();
-    const Eigen::Index m = last - first;
+    window.fit_begin = span.interval.a;
+    window.fit_end = span.interval.b;
+    const Eigen::Index m = span.count, distinct = span.distinct;
     window.samples = m;
-    Eigen::Index distinct = m > 0 ? 1 : 0;
-    for (Eigen::Index i = first + 1; i < last; ++i) distinct += t_[i] != t_[i - 1] ? 1 : 0;
-    const Interval interval{window.fit_begin, window.fit_end};
+    const Interval interval = span.interval;
     if (distinct < 2 || !(interval.b > interval.a)) {
       throw ComputeError(fmt::format("cannot fit a window at {:.6f} s..{:.6f} s: it has {} distinct stamps",
                                      window.fit_begin, window.fit_end, distinct));
     }
-    const auto tw = t_.segment(first, m);
-    const auto zw = z_.middleRows(first, m);
+    const auto tw = t_.segment(span.first, m);
+    const auto zw = z_.middleRows(span.first, m);
     const int d = static_cast<int>(z_.cols());
     window.degrees.assign(d, 0);
 
@@ -108,14 +104,12 @@ class WindowFitter {
       return window;
     }
 
-    int top = static_cast<int>(std::min<double>(
-        {static_cast<double>(options_.max_degree), std::floor(std::sqrt(options_.max_conditioning * m)),
-         static_cast<double>(distinct - 1)}));
+    int top = TopDegree(span);
     // A window far longer than its top degree needs (m > top², e.g. the whole of an hour-long
     // recording) is usually split: a subsample with N²/m = 2 (well conditioned, coefficient noise
     // still white) tells that at a fraction of the cost. Only its "unresolved" is trusted: a
     // subsample's noise plateau is higher, so it resolves no less than all the samples would.
-    const Eigen::Index stride = m / std::max<Eigen::Index>(Eigen::Index{top} * top / 2, 16 * (top + 1));
+    const Eigen::Index stride = SubsampleStride(m, top);
     if (may_split && stride >= 2 && !ResolvedOnSubsample(tw, zw, stride, top, interval)) return std::nullopt;
     bool lowered = false;
     // Cross-validation needs the normal equations of each fold; their sum is the whole window's,
@@ -215,6 +209,67 @@ class WindowFitter {
     window.verdict = (resolved || arbitrate) && consistent ? WindowVerdict::kResolved : WindowVerdict::kUnresolved;
     Finish(&window);
     return window;
+  }
+
+  // Whether the window of core [a, b] resolves the motion at its top degree (Fit's probe, the
+  // subsample's too) with a residual there clearly consistent with the noise: a lack-of-fit score
+  // of at most kSplitScore in every coordinate. Fit may split a window that does not for missed
+  // motion, which marks its pieces (CurveWindow::missed_motion); FitAdaptive cuts an end window
+  // unfitted only when it passes.
+  bool ResolvedAtTop(double a, double b, double segment_begin, double segment_end) const {
+    const Span span = Samples(a, b, segment_begin, segment_end);
+    if (span.distinct < 2 || !(span.interval.b > span.interval.a)) return false;
+    const int top = TopDegree(span);
+    const auto tw = t_.segment(span.first, span.count);
+    const auto zw = z_.middleRows(span.first, span.count);
+    const Eigen::Index stride = SubsampleStride(span.count, top);
+    if (stride >= 2 && !ResolvedOnSubsample(tw, zw, stride, top, span.interval)) return false;
+    const NormalEquations normal = BuildNormalEquations(tw, zw, top, span.interval);
+    try {
+      const NestedCholesky cholesky(normal, top);
+      if (!(cholesky.Condition(top) <= kMaxGramCondition)) return false;
+      const Eigen::MatrixXd high = cholesky.Solve(top, normal.rhs);
+      std::vector<int> degrees(static_cast<size_t>(zw.cols()));
+      if (!ChopDegrees(high, span.count, &degrees) && !TailIsNoise(high, cholesky)) return false;
+      const Centred centred = Centre(normal, zw);
+      const Eigen::VectorXd sigma = WindowSigma(tw, zw, false);
+      for (Eigen::Index c = 0; c < zw.cols(); ++c) {
+        if (!(centred.LackOfFit(cholesky, top, c, span.count, sigma[c]) <= kSplitScore)) return false;
+      }
+      return true;
+    } catch (const ComputeError&) {
+      return false;
+    }
+  }
+
+  // Whether the cross-validated degree of the window of core [a, b] certainly exceeds `degree` in
+  // some coordinate, told without the full search: the held-out errors of the search's grid up to
+  // three steps above `degree` (normal equations of that degree only), where some degree above it
+  // predicts better than every degree up to it, so the full search's minimum lies above it too.
+  // False when that cannot be told (a short window, held-out errors at the rounding level). The
+  // lack-of-fit test only raises degrees, so a window fitted in full would exceed it as well.
+  bool DegreeCertainlyAbove(double a, double b, double segment_begin, double segment_end, int degree) const {
+    const Span span = Samples(a, b, segment_begin, segment_end);
+    if (span.distinct < 2 || !(span.interval.b > span.interval.a)) return false;
+    const std::vector<int> full = DegreeGrid(TopDegree(span));
+    const auto above = std::upper_bound(full.begin(), full.end(), degree);
+    if (above == full.end()) return false;
+    const int reach = *std::min(above + 2, full.end() - 1);
+    const Folds folds = BuildFolds(t_.segment(span.first, span.count), z_.middleRows(span.first, span.count), reach,
+                                   span.interval);
+    const std::vector<int> grid = DegreeGrid(reach);
+    const Eigen::MatrixXd error = HeldOutErrors(folds, grid, reach);
+    for (Eigen::Index c = 0; c < error.cols(); ++c) {
+      double low = std::numeric_limits<double>::infinity(), high = low, spread = 0.0;
+      for (size_t g = 0; g < grid.size(); ++g) {
+        double& best = grid[g] <= degree ? low : high;
+        best = std::min(best, error(static_cast<Eigen::Index>(g), c));
+      }
+      for (const Eigen::RowVectorXd& squares : folds.squares) spread += squares[c];
+      // A margin far above the rounding of the two searches' sums, which may differ in the last bits.
+      if (high > kHeldOutFloor * spread && high < (1.0 - 1e-9) * low) return true;
+    }
+    return false;
   }
 
   // The noise σ per coordinate a window's residual is tested against: the data's, floored at a
@@ -381,6 +436,36 @@ class WindowFitter {
     return resolved;
   }
 
+  // The samples a window of core [a, b] is fitted to: its core extended by the overlap on each
+  // side, within its segment.
+  struct Span {
+    Interval interval;
+    Eigen::Index first = 0, count = 0, distinct = 0;
+  };
+  Span Samples(double a, double b, double segment_begin, double segment_end) const {
+    const double extension = options_.overlap * (b - a);
+    Span span;
+    span.interval = {std::max(a - extension, segment_begin), std::min(b + extension, segment_end)};
+    span.first = std::lower_bound(t_.data(), t_.data() + t_.size(), span.interval.a) - t_.data();
+    const Eigen::Index last = std::upper_bound(t_.data(), t_.data() + t_.size(), span.interval.b) - t_.data();
+    span.count = last - span.first;
+    span.distinct = span.count > 0 ? 1 : 0;
+    for (Eigen::Index i = span.first + 1; i < last; ++i) span.distinct += t_[i] != t_[i - 1] ? 1 : 0;
+    return span;
+  }
+
+  // The stride of Fit's subsample probe of m samples at degree top (below 2: none).
+  static Eigen::Index SubsampleStride(Eigen::Index m, int top) {
+    return m / std::max<Eigen::Index>(Eigen::Index{top} * top / 2, 16 * (top + 1));
+  }
+
+  // The highest degree a window may use: max_degree, N²/m ≤ max_conditioning, distinct stamps − 1.
+  int TopDegree(const Span& span) const {
+    return static_cast<int>(std::min<double>({static_cast<double>(options_.max_degree),
+                                              std::floor(std::sqrt(options_.max_conditioning * span.count)),
+                                              static_cast<double>(span.distinct - 1)}));
+  }
+
   // The normal equations of each cross-validation fold (sample i in fold i mod kFolds) of the
   // samples centred on their mean, with Σz² per fold, and their sum.
   static constexpr int kFolds = 5;
@@ -436,6 +521,21 @@ class WindowFitter {
   // block.
   static std::vector<int> CrossValidatedDegrees(const Folds& folds, int top, Eigen::VectorXd* best_error) {
     const std::vector<int> grid = DegreeGrid(top);
+    const Eigen::MatrixXd error = HeldOutErrors(folds, grid, top);
+    const Eigen::Index d = error.cols();
+    std::vector<int> degrees(static_cast<size_t>(d));
+    best_error->resize(d);
+    for (Eigen::Index c = 0; c < d; ++c) {
+      Eigen::Index best = 0;
+      (*best_error)[c] = error.col(c).minCoeff(&best);
+      degrees[static_cast<size_t>(c)] = grid[static_cast<size_t>(best)];
+    }
+    return degrees;
+  }
+
+  // The held-out squared error of each degree of `grid` (none above `top`, the folds' degree) and
+  // coordinate: grid.size() x d.
+  static Eigen::MatrixXd HeldOutErrors(const Folds& folds, const std::vector<int>& grid, int top) {
     const Eigen::Index d = folds.total.rhs.cols();
     Eigen::MatrixXd error = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(grid.size()), d);
     for (int fold = 0; fold < kFolds; ++fold) {
@@ -468,14 +568,7 @@ class WindowFitter {
         }
       }
     }
-    std::vector<int> degrees(static_cast<size_t>(d));
-    best_error->resize(d);
-    for (Eigen::Index c = 0; c < d; ++c) {
-      Eigen::Index best = 0;
-      (*best_error)[c] = error.col(c).minCoeff(&best);
-      degrees[static_cast<size_t>(c)] = grid[static_cast<size_t>(best)];
-    }
-    return degrees;
+    return error;
   }
 
   const Eigen::VectorXd& t_;
@@ -528,42 +621,75 @@ bool MissedMotion(const std::vector<CurveSegment>& segments) {
   return false;
 }
 
+int MaxDegree(const CurveWindow& window) { return *std::max_element(window.degrees.begin(), window.degrees.end()); }
+
 // Fits cores [a, b] of a segment adaptively: a core is halved until its series resolves or it
 // gets too small to split. Windows come out in time order.
 std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::VectorXd& t, const CurveSegment& segment,
                                      double a0, double b0, const CurveOptions& options) {
   std::vector<CurveWindow> windows;
-  // Cores to fit, with whether they are pieces of a window split for missed motion and, when
-  // SplitPredictsBetter fitted them already, that fit.
-  std::vector<std::tuple<double, double, bool, std::optional<HalfFit>>> stack;
-  stack.emplace_back(a0, b0, false, std::nullopt);
+  // A core to fit: whether it is a piece of a window split for missed motion, whether it is the
+  // end window RefineEnds would cut (below) and, when SplitPredictsBetter fitted it already, that fit.
+  struct Core {
+    double a, b;
+    bool piece = false, end_piece = false;
+    std::optional<HalfFit> fitted = std::nullopt;
+  };
+  std::vector<Core> stack;
+  stack.push_back({a0, b0});
+  const Eigen::Index end_minimum = 2 * std::max<Eigen::Index>(options.min_window_samples, kMinEndWindowSamples);
+  const bool refine_ends = options.end_degree > 0 && options.degree_method == DegreeMethod::kCrossValidation;
   while (!stack.empty()) {
-    auto [a, b, piece, fitted] = std::move(stack.back());
+    auto [a, b, piece, end_piece, fitted] = std::move(stack.back());
     stack.pop_back();
     const auto inside =
         std::upper_bound(t.data(), t.data() + t.size(), b) - std::lower_bound(t.data(), t.data() + t.size(), a);
     const bool may_split = inside >= 2 * options.min_window_samples;
+    // A window at an end of its segment whose degree exceeds end_degree is cut by RefineEnds when
+    // it is accepted and split when it is not. When that degree is certain, it is cut here unfitted,
+    // as RefineEnds would: the outer half is the end window to refine further (fitted without
+    // splitting, halved again while its degree exceeds end_degree), the inner half an ordinary core.
+    // A whole segment is cut at its front first, like RefineEnds does.
+    const bool front = a == segment.begin, back = b == segment.end;
+    const bool refinable = refine_ends && (front || back) && inside >= end_minimum;
+    if (refinable && !fitted &&
+        fitter.DegreeCertainlyAbove(a, b, segment.begin, segment.end, options.end_degree) &&
+        (end_piece || fitter.ResolvedAtTop(a, b, segment.begin, segment.end))) {
+      const double middle = 0.5 * (a + b);
+      stack.push_back({middle, b, false, back && !front});
+      stack.push_back({a, middle, false, front});
+      continue;
+    }
     Eigen::VectorXd held_out;
     bool undecided = false, missed = false;
     std::optional<CurveWindow> window;
-    // The fit SplitPredictsBetter made without splitting is this one when splitting is not
-    // allowed here either, or when it says the same call with splitting would return it.
-    if (fitted && (!may_split || fitted->reusable)) {
+    if (end_piece) {
+      window = fitter.Fit(a, b, segment.begin, segment.end, false);
+      if (refinable && MaxDegree(*window) > options.end_degree) {
+        const double middle = 0.5 * (a + b);
+        stack.push_back({middle, b, false, !front});
+        stack.push_back({a, middle, false, front});
+        continue;
+      }
+    } else if (fitted && (!may_split || fitted->reusable)) {
+      // The fit SplitPredictsBetter made without splitting is this one when splitting is not
+      // allowed here either, or when it says the same call with splitting would return it.
       window = std::move(fitted->window);
       held_out = std::move(fitted->held_out);
     } else {
       window = fitter.Fit(a, b, segment.begin, segment.end, may_split, &held_out, &undecided, &missed);
     }
     std::array<std::optional<HalfFit>, 2> halves;
-    if (window && may_split && SplitPredictsBetter(fitter, *window, held_out, segment, options, undecided, &halves)) {
+    if (window && may_split && !end_piece &&
+        SplitPredictsBetter(fitter, *window, held_out, segment, options, undecided, &halves)) {
       window.reset();
       missed = true;
     }
     if (!window) {
       const double middle = 0.5 * (a + b);
       // The left half is popped first: windows stay in time order.
-      stack.emplace_back(middle, b, piece || missed, std::move(halves[1]));
-      stack.emplace_back(a, middle, piece || missed, std::move(halves[0]));
+      stack.push_back({middle, b, piece || missed, false, std::move(halves[1])});
+      stack.push_back({a, middle, piece || missed, false, std::move(halves[0])});
       continue;
     }
     window->missed_motion = piece;
@@ -582,7 +708,6 @@ std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::Ve
 void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegment& segment,
                 const CurveOptions& options) {
   if (options.end_degree <= 0) return;
-  auto max_degree = [](const CurveWindow& w) { return *std::max_element(w.degrees.begin(), w.degrees.end()); };
   auto samples_in = [&t](double a, double b) {
     return std::upper_bound(t.data(), t.data() + t.size(), b) - std::lower_bound(t.data(), t.data() + t.size(), a);
   };
@@ -590,7 +715,7 @@ void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegme
     while (true) {
       auto& windows = segment.windows;
       const CurveWindow& end = front ? windows.front() : windows.back();
-      if (max_degree(end) <= options.end_degree ||
+      if (MaxDegree(end) <= options.end_degree ||
           samples_in(end.core_begin, end.core_end) < 2 * std::max<Eigen::Index>(options.min_window_samples, kMinEndWindowSamples)) {
         break;
       }
@@ -607,7 +732,7 @@ void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegme
       const Eigen::Index minimum = 2 * std::max<Eigen::Index>(options.min_window_samples, kMinEndWindowSamples);
       const bool predict = options.degree_method == DegreeMethod::kCrossValidation;
       std::vector<double> cuts{front ? b : a};  // from the inside out
-      for (double degree = max_degree(end); degree > options.end_degree && (predict || cuts.size() < 2); degree *= 0.5) {
+      for (double degree = MaxDegree(end); degree > options.end_degree && (predict || cuts.size() < 2); degree *= 0.5) {
         if (cuts.size() > 1 && (front ? samples_in(a, cuts.back()) : samples_in(cuts.back(), b)) < minimum) break;
         cuts.push_back(front ? 0.5 * (a + cuts.back()) : 0.5 * (cuts.back() + b));
       }
@@ -616,9 +741,9 @@ void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegme
                      : *fitter.Fit(cut, b, segment.begin, segment.end, false);
       };
       CurveWindow outer = fit_end(cuts.back());
-      while (cuts.size() > 2 && max_degree(outer) <= options.end_degree) {
+      while (cuts.size() > 2 && MaxDegree(outer) <= options.end_degree) {
         CurveWindow larger = fit_end(cuts[cuts.size() - 2]);
-        if (max_degree(larger) > options.end_degree) break;
+        if (MaxDegree(larger) > options.end_degree) break;
         cuts.pop_back();
         outer = std::move(larger);
       }
