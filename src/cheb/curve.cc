@@ -554,19 +554,13 @@ class WindowFitter {
           solvable = solvable > 8 ? static_cast<int>(0.8 * solvable) : solvable - 1;
         }
       }
-      for (size_t g = 0; g < grid.size(); ++g) {
-        const auto row = static_cast<Eigen::Index>(g);
-        if (!cholesky || grid[g] > solvable) {
-          error.row(row).setConstant(std::numeric_limits<double>::infinity());
-          continue;
-        }
-        const int n = grid[g] + 1;
-        const Eigen::MatrixXd c = cholesky->Solve(grid[g], train.rhs);  // n x d
-        const Eigen::MatrixXd gc = held_out.gram.topLeftCorner(n, n).selfadjointView<Eigen::Lower>() * c;
-        for (Eigen::Index k = 0; k < d; ++k) {
-          error(row, k) += folds.squares[fold][k] - 2.0 * c.col(k).dot(held_out.rhs.col(k).head(n)) + c.col(k).dot(gc.col(k));
-        }
+      // The grid is ascending: the degrees a solvable training system can score come first.
+      const auto solved = cholesky ? std::upper_bound(grid.begin(), grid.end(), solvable) - grid.begin() : 0;
+      if (solved > 0) {
+        error.topRows(solved) += cholesky->HeldOutErrors(train.rhs, held_out, folds.squares[fold],
+                                                         std::vector<int>(grid.begin(), grid.begin() + solved));
       }
+      error.bottomRows(static_cast<Eigen::Index>(grid.size()) - solved).setConstant(std::numeric_limits<double>::infinity());
     }
     return error;
   }
@@ -857,9 +851,10 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
 
   // Jumps and glitches (CurveOptions::robust): outliers leave the fit, jumps split it.
   internal::Jumps jumps;
+  Eigen::VectorXd noise;  // of the samples split at the gaps
   if (options.robust) {
-    const Eigen::VectorXd noise = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
-                                                      : EstimateNoiseSigma(t, z, gaps);
+    noise = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
+                                : EstimateNoiseSigma(t, z, gaps);
     jumps = internal::FindJumps(t, z, gaps, noise);
   }
   std::vector<char> kept(static_cast<size_t>(m), 1);
@@ -920,8 +915,11 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   std::vector<Eigen::Index> cuts;
   for (const auto& [b, jump] : boundaries) cuts.push_back(b);
 
+  // Taken again where the search found something (fewer samples, steps out, more cuts).
+  const bool found = !jumps.outliers.empty() || !jumps.steps.empty() || !jumps.breaks.empty();
   curve.noise_sigma_ = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
-                                           : EstimateNoiseSigma(t, z, cuts);
+                       : noise.size() > 0 && !found ? noise
+                                                    : EstimateNoiseSigma(t, z, cuts);
   const WindowFitter fitter(t, z, curve.noise_sigma_, options);
 
   // Segment boundaries [starts[k], starts[k+1]), with whether each segment ends at a jump; a

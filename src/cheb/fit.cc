@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <vector>
 
 #include <Eigen/Cholesky>
 #include <fmt/format.h>
@@ -196,6 +197,23 @@ NormalEquations BuildNormalEquationsUnchecked(const Eigen::Ref<const Eigen::Vect
   return normal;
 }
 
+namespace {
+
+// Σ a_k b_k over n values, in kLanes independent sums (vectorised without reassociating).
+CHEVAL_MULTIVERSION double Dot(const double* a, const double* b, Eigen::Index n) {
+  double lanes[kLanes] = {};
+  Eigen::Index k = 0;
+  for (; k + kLanes <= n; k += kLanes) {
+    for (int r = 0; r < kLanes; ++r) lanes[r] += a[k + r] * b[k + r];
+  }
+  double sum = 0.0;
+  for (; k < n; ++k) sum += a[k] * b[k];
+  for (int r = 0; r < kLanes; ++r) sum += lanes[r];
+  return sum;
+}
+
+}  // namespace
+
 NestedCholesky::NestedCholesky(const NormalEquations& normal, int degree) {
   if (degree < 0 || degree > normal.top_degree()) {
     throw std::invalid_argument("NestedCholesky: degree outside the normal equations");
@@ -213,6 +231,44 @@ NestedCholesky::NestedCholesky(const NormalEquations& normal, int degree) {
         "(too few distinct stamps?)",
         degree, normal.samples));
   }
+}
+
+Eigen::MatrixXd NestedCholesky::HeldOutErrors(const Eigen::Ref<const Eigen::MatrixXd>& train_rhs,
+                                              const NormalEquations& held_out, const Eigen::RowVectorXd& squares,
+                                              const std::vector<int>& degrees) const {
+  const Eigen::Index d = train_rhs.cols();
+  Eigen::MatrixXd error(static_cast<Eigen::Index>(degrees.size()), d);
+  if (degrees.empty()) return error;
+  const int top = *std::max_element(degrees.begin(), degrees.end());
+  if (degrees.front() < 0 || top > degree() || train_rhs.rows() < top + 1 || held_out.top_degree() < top ||
+      squares.size() != d || held_out.rhs.cols() != d) {
+    throw std::invalid_argument("NestedCholesky::HeldOutErrors: degrees outside the factorisation or systems");
+  }
+  // The forward half of every solve is the leading part of one: y = L⁻¹ b (L is lower triangular).
+  const Eigen::MatrixXd y =
+      factor_.topLeftCorner(top + 1, top + 1).triangularView<Eigen::Lower>().solve(train_rhs.topRows(top + 1));
+  Eigen::MatrixXd c(top + 1, d);
+  for (size_t g = 0; g < degrees.size(); ++g) {
+    const Eigen::Index n = degrees[g] + 1;
+    // Back substitution Lᵀc = y over the leading n rows: row i of Lᵀ is column i of L below the diagonal.
+    for (Eigen::Index i = n - 1; i >= 0; --i) {
+      const double* below = factor_.data() + i * factor_.outerStride() + i + 1;
+      for (Eigen::Index k = 0; k < d; ++k) {
+        c(i, k) = (y(i, k) - Dot(below, c.data() + k * c.outerStride() + i + 1, n - 1 - i)) / factor_(i, i);
+      }
+    }
+    // Σz² − 2cᵀb + cᵀGc of the held-out samples.
+    for (Eigen::Index k = 0; k < d; ++k) {
+      const double* ck = c.data() + k * c.outerStride();
+      double quadratic = 0.0;
+      for (Eigen::Index j = 0; j < n; ++j) {
+        quadratic += ck[j] * Dot(held_out.gram.data() + j * held_out.gram.outerStride(), ck, n);
+      }
+      error(static_cast<Eigen::Index>(g), k) =
+          squares[k] - 2.0 * Dot(ck, held_out.rhs.data() + k * held_out.rhs.outerStride(), n) + quadratic;
+    }
+  }
+  return error;
 }
 
 double NestedCholesky::Condition(int degree) const {

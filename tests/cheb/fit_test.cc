@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include <Eigen/LU>
 #include <Eigen/QR>
@@ -72,6 +73,46 @@ TEST(NestedCholesky, LeadingBlocksGiveEveryLowerDegreeFit) {
         << degree;
   }
   EXPECT_THROW(cholesky.Solve(top + 1, equations.rhs), std::invalid_argument);
+}
+
+// A cross-validation fold's held-out errors from normal equations alone equal the squared
+// residuals of each degree's training fit evaluated on the held-out samples themselves.
+TEST(NestedCholesky, HeldOutErrorsEqualResidualsOnTheHeldOutSamples) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> normal;
+  const int m = 900, top = 30;
+  const Interval interval{0.0, 9.0};
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(m, 0.0, 9.0);
+  Eigen::MatrixXd z(m, 3);
+  for (int i = 0; i < m; ++i) {
+    z.row(i) << std::sin(t[i]) + 0.01 * normal(rng), std::cos(3 * t[i]) + 0.01 * normal(rng), 0.1 * t[i];
+  }
+  std::vector<Eigen::Index> train_rows, held_rows;
+  for (int i = 0; i < m; ++i) (i % 5 == 2 ? held_rows : train_rows).push_back(i);
+  auto rows = [&](const std::vector<Eigen::Index>& r, const Eigen::MatrixXd& a) { return Eigen::MatrixXd(a(r, Eigen::all)); };
+  const Eigen::VectorXd train_t = rows(train_rows, t), held_t = rows(held_rows, t);
+  const Eigen::MatrixXd train_z = rows(train_rows, z), held_z = rows(held_rows, z);
+  const NormalEquations train = BuildNormalEquations(train_t, train_z, top, interval);
+  const NormalEquations held_out = BuildNormalEquationsUnchecked(held_t, held_z, top, interval);
+  const NestedCholesky cholesky(train, top);
+  const std::vector<int> degrees{1, 4, 9, 17, 30};
+  const Eigen::MatrixXd errors =
+      cholesky.HeldOutErrors(train.rhs, held_out, held_z.colwise().squaredNorm(), degrees);
+  ASSERT_EQ(errors.rows(), 5);
+  ASSERT_EQ(errors.cols(), 3);
+  Eigen::VectorXd x(held_t.size());
+  for (Eigen::Index i = 0; i < x.size(); ++i) x[i] = interval.ToUnit(held_t[i]);
+  for (size_t g = 0; g < degrees.size(); ++g) {
+    const Eigen::MatrixXd residual = held_z - EvaluateSeries(cholesky.Solve(degrees[g], train.rhs), x);
+    for (Eigen::Index c = 0; c < 3; ++c) {
+      const double expected = residual.col(c).squaredNorm();
+      // Σz² − 2cᵀb + cᵀGc cancels down from Σz² (~ held-out count) to the residual: rounding of 1e-12.
+      EXPECT_NEAR(errors(static_cast<Eigen::Index>(g), c), expected, 1e-12 * held_z.col(c).squaredNorm() + 1e-9 * expected)
+          << "degree " << degrees[g] << " coordinate " << c;
+    }
+  }
+  EXPECT_THROW(cholesky.HeldOutErrors(train.rhs, held_out, held_z.colwise().squaredNorm(), {top + 1}),
+               std::invalid_argument);
 }
 
 TEST(FitLeastSquares, ReproducesPolynomialsExactly) {

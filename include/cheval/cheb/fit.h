@@ -3,6 +3,8 @@
 /// Weighted least-squares fitting of vector samples by a Chebyshev polynomial, in O(m·N) without
 /// forming the m x (N + 1) design matrix (docs/velocity.md, "Formulas").
 
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "cheval/cheb/chebyshev.h"
@@ -78,6 +80,14 @@ class NestedCholesky {
   /// The same for coefficients first..degree only (degree − first + 1 values): column k of L⁻¹
   /// is zero above row k, so only the trailing block of L is inverted.
   Eigen::VectorXd VarianceFactors(int degree, int first) const;
+  /// Held-out squared errors Σz² − 2cᵀb + cᵀGc (degrees.size() x d) of the fit of each degree of
+  /// `degrees` (ascending, each at most degree()) to the right-hand sides `train_rhs` of the
+  /// factorised system, on held-out samples given by their normal equations `held_out` (built up
+  /// to at least the largest degree) and Σz² per coordinate `squares`: a cross-validation's score
+  /// of every candidate degree in O(N²) each (the forward substitution is shared, L being lower
+  /// triangular).
+  Eigen::MatrixXd HeldOutErrors(const Eigen::Ref<const Eigen::MatrixXd>& train_rhs, const NormalEquations& held_out,
+                                const Eigen::RowVectorXd& squares, const std::vector<int>& degrees) const;
 
  private:
   Eigen::MatrixXd factor_;  // lower triangular L
