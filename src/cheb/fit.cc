@@ -244,9 +244,8 @@ Eigen::MatrixXd NestedCholesky::HeldOutErrors(const Eigen::Ref<const Eigen::Matr
       squares.size() != d || held_out.rhs.cols() != d) {
     throw std::invalid_argument("NestedCholesky::HeldOutErrors: degrees outside the factorisation or systems");
   }
-  // The forward half of every solve is the leading part of one: y = L⁻¹ b (L is lower triangular).
-  const Eigen::MatrixXd y =
-      factor_.topLeftCorner(top + 1, top + 1).triangularView<Eigen::Lower>().solve(train_rhs.topRows(top + 1));
+  // The forward half of every solve is the leading part of one.
+  const Eigen::MatrixXd y = Whiten(top, train_rhs);
   Eigen::MatrixXd c(top + 1, d);
   for (size_t g = 0; g < degrees.size(); ++g) {
     const Eigen::Index n = degrees[g] + 1;
@@ -274,6 +273,13 @@ Eigen::MatrixXd NestedCholesky::HeldOutErrors(const Eigen::Ref<const Eigen::Matr
 double NestedCholesky::Condition(int degree) const {
   const Eigen::ArrayXd pivots = factor_.diagonal().head(degree + 1).array().square();
   return pivots.maxCoeff() / pivots.minCoeff();
+}
+
+Eigen::MatrixXd NestedCholesky::Whiten(int degree, const Eigen::Ref<const Eigen::MatrixXd>& rhs) const {
+  if (degree < 0 || degree > this->degree() || rhs.rows() < degree + 1) {
+    throw std::invalid_argument("NestedCholesky::Whiten: degree outside the factorisation");
+  }
+  return factor_.topLeftCorner(degree + 1, degree + 1).triangularView<Eigen::Lower>().solve(rhs.topRows(degree + 1));
 }
 
 Eigen::MatrixXd NestedCholesky::Solve(int degree, const Eigen::Ref<const Eigen::MatrixXd>& rhs) const {

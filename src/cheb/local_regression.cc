@@ -28,6 +28,8 @@ constexpr double kSignificance = 2.0;
 constexpr Eigen::Index kBlock = 53;
 // Shorter stretches are left to the windows: fewer than 4 blocks say little about the scatter.
 constexpr Eigen::Index kMinStretch = 4 * kBlock;
+// The most blocks of a stretch scored (LocalRegressionRuns).
+constexpr Eigen::Index kMaxScoredBlocks = 64;
 // Windows whose rates differ from the pilot's by less than this fraction of the noise variance
 // that σ implies are left alone (σ overstates the noise there).
 constexpr double kSmoothFraction = 0.25;
@@ -214,11 +216,13 @@ class WindowWeights {
       u_previous = u_current, u_current = next;
     }
     derivative *= interval.DerivativeScale();
+    // T'ᵀG⁻¹u and T'ᵀG⁻¹T' at each coordinate's degree from one forward solve of each (NestedCholesky::Whiten).
+    const Eigen::VectorXd whitened_u = cholesky_->Whiten(top_, u), whitened_derivative = cholesky_->Whiten(top_, derivative);
     for (Eigen::Index c = 0; c < d; ++c) {
       const int degree = window_.degrees[static_cast<size_t>(c)];
       if (degree < 1) continue;
-      product[c] = derivative.head(degree + 1).dot(cholesky_->Solve(degree, u).col(0));
-      (*norm)[c] = derivative.head(degree + 1).dot(cholesky_->Solve(degree, derivative).col(0));
+      product[c] = whitened_derivative.head(degree + 1).dot(whitened_u.head(degree + 1));
+      (*norm)[c] = whitened_derivative.head(degree + 1).squaredNorm();
     }
     return product;
   }
@@ -339,9 +343,21 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
       s0 = s1;
       continue;
     }
-    StretchScores scores(count, d, length);
+    // A stretch of more than kMaxScoredBlocks blocks is scored on that many, spread evenly over it:
+    // the choice rests on means over samples and their standard error from the blocks' scatter,
+    // which a systematic sample of blocks estimates as well, at a cost bounded per stretch (a
+    // 720k-sample drone flight has stretches of 315k samples, which took a minute to score).
+    const Eigen::Index stretch_blocks = length / kBlock;
+    const bool sampled = stretch_blocks > kMaxScoredBlocks;
+    StretchScores scores(count, d, sampled ? kMaxScoredBlocks * kBlock : length);
+    std::vector<Eigen::Index> scored;  // the samples scored, in order
+    for (Eigen::Index b = 0; b < (sampled ? kMaxScoredBlocks : 1); ++b) {
+      const Eigen::Index begin = sampled ? s0 + b * stretch_blocks / kMaxScoredBlocks * kBlock : s0;
+      for (Eigen::Index i = begin; i < (sampled ? begin + kBlock : s1); ++i) scored.push_back(i);
+    }
     Eigen::VectorXd norm(d);
-    for (Eigen::Index i = s0; i < s1; ++i) {
+    for (size_t q = 0; q < scored.size(); ++q) {
+      const Eigen::Index i = scored[q];
       const LocalFits fits(ts, zs, i);
       const Regression pilot = fits.Fit(pilot_h, kMaxDegree);
       const Regression reference = fits.Fit(bias_h, kMaxDegree);
@@ -356,7 +372,7 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
       scores.window_differences += window_difference;
       scores.window_products += product;
       scores.window_spread += ((norm - 2.0 * product).array() + WeightNorm(pilot)).matrix();
-      const auto block = static_cast<size_t>(std::min(scores.blocks - 1, (i - s0) / kBlock));
+      const auto block = static_cast<size_t>(std::min(scores.blocks - 1, static_cast<Eigen::Index>(q) / kBlock));
       for (Eigen::Index a = 0; a < count; ++a) {
         const auto [h, degree] = candidates[static_cast<size_t>(a)];
         const Regression r = fits.Fit(h, degree);

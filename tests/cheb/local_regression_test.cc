@@ -20,12 +20,12 @@ struct Case {
 
 // The handheld motion (100 Hz, 20 s) with 1/0.8/0.6 mm at 7/5.3/9.1 Hz added, noise σ and 0.3 ms
 // of stamp jitter: the "tremor" rows of bench/velocity_accuracy.cc.
-Case Tremor(uint64_t seed, double noise_m) {
+Case Tremor(uint64_t seed, double noise_m, double duration_s = 20) {
   sim::MotionOptions options;
   options.kind = sim::MotionKind::kHandheld;
   options.seed = seed;
   options.rate_hz = 100;
-  options.duration_s = 20;
+  options.duration_s = duration_s;
   const sim::MotionModel model(options);
   sim::MeasurementOptions measurement;
   measurement.noise_m = noise_m;
@@ -76,6 +76,17 @@ TEST(LocalRegression, OtherSeedsGainToo) {
     const double without = VelocityRmse(FitCurve(c.stamps, c.positions, windows_only), c);
     EXPECT_LT(with, 0.8 * without) << "seed " << seed;
   }
+}
+
+// Two minutes of it: the stretches are longer than the blocks a stretch is scored on, which are
+// spread over it, and the regression still takes over and gains as much.
+TEST(LocalRegression, LongStretchesAreScoredOnASampleOfBlocks) {
+  const Case c = Tremor(1, 5e-4, 120);
+  const Curve curve = FitCurve(c.stamps, c.positions);
+  CurveOptions windows_only;
+  windows_only.local_regression = false;
+  EXPECT_GT(curve.regression_samples(), 8000);
+  EXPECT_LT(VelocityRmse(curve, c), 0.8 * VelocityRmse(FitCurve(c.stamps, c.positions, windows_only), c));
 }
 
 // Noise-free, the windows resolve the tremor to ~7 µm/s: the data's σ (the tremor's own 4th

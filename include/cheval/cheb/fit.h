@@ -74,6 +74,10 @@ class NestedCholesky {
   /// Coefficients ((degree + 1) x d) of the degree-`degree` fit to right-hand sides whose first
   /// degree + 1 rows are used (e.g. NormalEquations::rhs).
   Eigen::MatrixXd Solve(int degree, const Eigen::Ref<const Eigen::MatrixXd>& rhs) const;
+  /// L⁻¹·rhs over the leading degree + 1 rows of `rhs` ((degree + 1) x d): with G = L·Lᵀ,
+  /// aᵀG⁻¹b = (L⁻¹a)ᵀ(L⁻¹b) for the block of that degree, and L being lower triangular, the
+  /// leading rows of the result are those of every lower degree (one solve serves them all).
+  Eigen::MatrixXd Whiten(int degree, const Eigen::Ref<const Eigen::MatrixXd>& rhs) const;
   /// diag(G⁻¹) of the degree-`degree` block: with unit weights and white noise of standard
   /// deviation σ, coefficient k of that fit has standard deviation σ·sqrt(factor_k).
   Eigen::VectorXd VarianceFactors(int degree) const { return VarianceFactors(degree, 0); }
