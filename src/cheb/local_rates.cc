@@ -15,6 +15,35 @@ constexpr double kSpikeScales = 4.0;
 constexpr Eigen::Index kBlock = 64;
 // Held-out samples a window needs for its interpolant's error to be compared with its own.
 constexpr double kMinHeldOut = 8;
+// UnderResolvedRates' code for the interpolating spline's slopes.
+constexpr int kSpline = 9;
+
+// The slopes of the cubic spline through (times, values) that are C² at rows a..b, given the
+// slopes at rows a − 1 and b + 1 (clamped): the tridiagonal system
+// h_r·s_{r−1} + 2(h_{r−1} + h_r)·s_r + h_{r−1}·s_{r+1} = 3(h_r·d_{r−1} + h_{r−1}·d_r), h_r and d_r
+// the step and slope from row r to r + 1, solved in place of `rates` (Thomas' algorithm).
+void SplineSlopes(const std::vector<double>& times, const Eigen::Ref<const Eigen::VectorXd>& values, Eigen::Index a,
+                  Eigen::Index b, Eigen::Ref<Eigen::VectorXd> rates) {
+  const Eigen::Index k = b - a + 1;
+  std::vector<double> upper(static_cast<size_t>(k)), rhs(static_cast<size_t>(k));
+  double previous_upper = 0.0, previous_rhs = 0.0;
+  for (Eigen::Index r = a; r <= b; ++r) {
+    const double h0 = times[r] - times[r - 1], h1 = times[r + 1] - times[r];
+    const double d0 = (values[r] - values[r - 1]) / h0, d1 = (values[r + 1] - values[r]) / h1;
+    const double lower = h1, diagonal = 2.0 * (h0 + h1);
+    double right = 3.0 * (h1 * d0 + h0 * d1), up = h0;
+    if (r == a) right -= lower * rates[a - 1];
+    if (r == b) right -= up * rates[b + 1], up = 0.0;
+    const double pivot = diagonal - (r == a ? 0.0 : lower * previous_upper);
+    previous_upper = up / pivot;
+    previous_rhs = (right - (r == a ? 0.0 : lower * previous_rhs)) / pivot;
+    upper[static_cast<size_t>(r - a)] = previous_upper;
+    rhs[static_cast<size_t>(r - a)] = previous_rhs;
+  }
+  rates[b] = rhs[static_cast<size_t>(k - 1)];
+  for (Eigen::Index r = b - 1; r >= a; --r) rates[r] = rhs[static_cast<size_t>(r - a)] - upper[static_cast<size_t>(r - a)] * rates[r + 1];
+}
+
 // HeldOut at even spacing: the weights of z_{i-k} .. z_{i+k} (k = 2, 3, 4) and the gains.
 constexpr double kEvenWeights[3][9] = {
     {1.0 / 6, -4.0 / 6, 6.0 / 6, -4.0 / 6, 1.0 / 6},
@@ -188,9 +217,16 @@ Eigen::ArrayXXi UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::Matrix
       const double scale = 6.0 / (u * u) * frequency, inverse_h2 = spacing[k] / used[k];
       const double bias3 = scale * (1.0 - std::sin(omega_h) / omega_h);
       const double bias5 = scale * (1.0 - (8.0 * std::sin(omega_h) - std::sin(2.0 * omega_h)) / (6.0 * omega_h));
+      // The interpolating cubic spline's slopes (C² at the samples): Σw² = 1.392/h², fraction
+      // 1 − 3 sin(ωh)/(ωh(2 + cos ωh)).
+      const double bias_spline = scale * (1.0 - 3.0 * std::sin(omega_h) / (omega_h * (2.0 + std::cos(omega_h))));
       const double error3 = noise * 0.5 * inverse_h2 + motion * bias3 * bias3;
       const double error5 = noise * 130.0 / 144.0 * inverse_h2 + motion * bias5 * bias5;
-      if (missed > 0.0 && missed * frequency * frequency > std::min(error3, error5)) stencil(k, c) = error5 < error3 ? 5 : 3;
+      const double error_spline = noise * 1.392 * inverse_h2 + motion * bias_spline * bias_spline;
+      const double best = std::min({error3, error5, error_spline});
+      if (missed > 0.0 && missed * frequency * frequency > best) {
+        stencil(k, c) = best == error_spline ? kSpline : best == error5 ? 5 : 3;
+      }
     }
   }
   return stencil;
@@ -215,9 +251,10 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
       Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, false);
   const std::vector<CurveWindow>& windows = segment.windows;
   const Eigen::ArrayXXi stencil = UnderResolvedRates(t, z, first, last, segment);
-  // Samples whose rate is the 5-point one (UnderResolvedRates).
+  // Samples whose rate is the 5-point one, and the spline's (UnderResolvedRates).
   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> five =
       Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, false);
+  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> spline = five;
   size_t w = 0;
   bool any = false;
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -232,6 +269,7 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
                      window.residual_rms[c] >= std::sqrt(2.0) * sigma[c]) ||
                     under > 0;
       five(i, c) = under == 5;
+      spline(i, c) = under == kSpline;
       any = any || local(i, c);
     }
   }
@@ -277,11 +315,13 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
     LocalRun run;
     run.values.resize(stop - begin, d);
     run.rates.resize(stop - begin, d);
+    std::vector<Eigen::Index> index;  // the sample of each row
     for (Eigen::Index k = begin; k < stop; ++k) {
       // A sample at the stamp of the one before it adds no interval (the first one stays).
       if (!run.times.empty() && !(t[first + k] > run.times.back())) continue;
       const auto r = static_cast<Eigen::Index>(run.times.size());
       run.times.push_back(t[first + k]);
+      index.push_back(k);
       for (Eigen::Index c = 0; c < d; ++c) {
         if (local(k, c)) {
           run.values(r, c) = z(first + k, c);
@@ -290,6 +330,26 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
           run.values(r, c) = fit_values(first + k, c);
           run.rates(r, c) = fit_rates(first + k, c);
         }
+      }
+    }
+    // Where the spline's slopes were chosen: maximal stretches of inner rows whose slopes on either
+    // side are usable, clamped at the rates of the rows around them.
+    const auto rows = static_cast<Eigen::Index>(run.times.size());
+    for (Eigen::Index c = 0; c < d; ++c) {
+      auto splined = [&](Eigen::Index r) {
+        const Eigen::Index k = index[static_cast<size_t>(r)];
+        return r >= 1 && r + 1 < rows && spline(k, c) && local(k, c) && k >= 1 && usable(k - 1, c) && k + 1 < n &&
+               usable(k, c) && index[static_cast<size_t>(r - 1)] == k - 1 && index[static_cast<size_t>(r + 1)] == k + 1;
+      };
+      for (Eigen::Index r = 1; r + 1 < rows;) {
+        if (!splined(r)) {
+          ++r;
+          continue;
+        }
+        Eigen::Index b = r;
+        while (b + 1 < rows - 1 && splined(b + 1)) ++b;
+        SplineSlopes(run.times, run.values.col(c).head(rows), r, b, run.rates.col(c).head(rows));
+        r = b + 1;
       }
     }
     i = end;
