@@ -12,8 +12,8 @@ namespace cheval::cheb::internal {
 
 /// Per window of `segment` (rows) and coordinate (columns), where the samples under-resolve the
 /// motion: the local rate that does better than the window's fit, 3 (the derivative of the
-/// quadratic through a sample and its neighbours) or 5 (of the quartic through it and two
-/// neighbours on either side), else 0. Needs no σ (the noise estimate reads such motion as noise).
+/// quadratic through a sample and its neighbours), 5 (of the quartic through it and two
+/// neighbours on either side) or 9 (the slopes of the cubic spline through the samples), else 0. Needs no σ (the noise estimate reads such motion as noise).
 /// Over the window's core, the held-out errors of the polynomials of degree 3, 5 and 7 through 2,
 /// 3 and 4 neighbours on either side must fall by more than half from each order to the next
 /// (white noise keeps them level; motion of frequency ω lowers each by u·(6/20)² and u·(20/70)²,
@@ -40,7 +40,8 @@ bool UnderResolvedAnywhere(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, c
 ///
 /// The rate at a local sample is the derivative of the quadratic through it and its two
 /// neighbours (one-sided at the segment's ends; of the quartic through it and two neighbours on
-/// either side where UnderResolvedRates chose 5), from slopes between consecutive samples that are
+/// either side where UnderResolvedRates chose 5; the clamped cubic spline's slopes over stretches
+/// where it chose 9), from slopes between consecutive samples that are
 /// not isolated spikes: a slope whose departure from the mean of its two neighbours is above 4
 /// local scales (1.4826·median departure over 64 slopes, floored at the noise's sqrt(5)·σ/h) and
 /// larger than its neighbours' is a small step of the values the jump search left (a correction of
