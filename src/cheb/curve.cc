@@ -990,7 +990,8 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   }
 
   // Where windows clearly missed motion, the samples' own local interpolant (docs/velocity.md).
-  if (options.lack_of_fit && adaptive && curve.unresolved_windows() > 0) {
+  if (options.lack_of_fit && adaptive &&
+      (curve.unresolved_windows() > 0 || internal::UnderResolvedAnywhere(t, z, starts, curve.segments_))) {
     Eigen::MatrixXd fit_values, fit_rates;
     curve.EvaluateMany(sorted, 1, &fit_values, &fit_rates);
     for (Eigen::Index i = 0; i < fitted_count; ++i) {  // the fitted values without the steps, as z

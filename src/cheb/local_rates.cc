@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace cheval::cheb::internal {
@@ -12,6 +13,45 @@ namespace {
 constexpr double kSpikeScales = 4.0;
 // Slopes per block of the local scale.
 constexpr Eigen::Index kBlock = 64;
+// Held-out samples a window needs for its interpolant's error to be compared with its own.
+constexpr double kMinHeldOut = 8;
+// UnderResolvedRates' code for the interpolating spline's slopes.
+constexpr int kSpline = 9;
+
+// The slopes of the cubic spline through (times, values) that are C² at rows a..b, given the
+// slopes at rows a − 1 and b + 1 (clamped): the tridiagonal system
+// h_r·s_{r−1} + 2(h_{r−1} + h_r)·s_r + h_{r−1}·s_{r+1} = 3(h_r·d_{r−1} + h_{r−1}·d_r), h_r and d_r
+// the step and slope from row r to r + 1, solved in place of `rates` (Thomas' algorithm).
+void SplineSlopes(const std::vector<double>& times, const Eigen::Ref<const Eigen::VectorXd>& values, Eigen::Index a,
+                  Eigen::Index b, Eigen::Ref<Eigen::VectorXd> rates) {
+  const Eigen::Index k = b - a + 1;
+  std::vector<double> upper(static_cast<size_t>(k)), rhs(static_cast<size_t>(k));
+  double previous_upper = 0.0, previous_rhs = 0.0;
+  for (Eigen::Index r = a; r <= b; ++r) {
+    const double h0 = times[r] - times[r - 1], h1 = times[r + 1] - times[r];
+    const double d0 = (values[r] - values[r - 1]) / h0, d1 = (values[r + 1] - values[r]) / h1;
+    const double lower = h1, diagonal = 2.0 * (h0 + h1);
+    double right = 3.0 * (h1 * d0 + h0 * d1), up = h0;
+    if (r == a) right -= lower * rates[a - 1];
+    if (r == b) right -= up * rates[b + 1], up = 0.0;
+    const double pivot = diagonal - (r == a ? 0.0 : lower * previous_upper);
+    previous_upper = up / pivot;
+    previous_rhs = (right - (r == a ? 0.0 : lower * previous_rhs)) / pivot;
+    upper[static_cast<size_t>(r - a)] = previous_upper;
+    rhs[static_cast<size_t>(r - a)] = previous_rhs;
+  }
+  rates[b] = rhs[static_cast<size_t>(k - 1)];
+  for (Eigen::Index r = b - 1; r >= a; --r) rates[r] = rhs[static_cast<size_t>(r - a)] - upper[static_cast<size_t>(r - a)] * rates[r + 1];
+}
+
+// HeldOut at even spacing: the weights of z_{i-k} .. z_{i+k} (k = 2, 3, 4) and the gains.
+constexpr double kEvenWeights[3][9] = {
+    {1.0 / 6, -4.0 / 6, 6.0 / 6, -4.0 / 6, 1.0 / 6},
+    {-1.0 / 20, 6.0 / 20, -15.0 / 20, 20.0 / 20, -15.0 / 20, 6.0 / 20, -1.0 / 20},
+    {1.0 / 70, -8.0 / 70, 28.0 / 70, -56.0 / 70, 70.0 / 70, -56.0 / 70, 28.0 / 70, -8.0 / 70, 1.0 / 70}};
+constexpr double kEvenGains[3] = {70.0 / 36, 924.0 / 400, 12870.0 / 4900};
+// Each order's held-out error below this fraction of the one before: motion, not noise.
+constexpr double kUnderResolved = 0.5;
 
 // Which slopes (between samples j and j + 1 of the segment, per coordinate) are not spikes.
 Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> UsableSlopes(const Eigen::VectorXd& h, const Eigen::MatrixXd& slopes,
@@ -53,7 +93,152 @@ Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> UsableSlopes(const Eigen::Vec
   return usable;
 }
 
+// The held-out error at sample i of the polynomial of degree 2k − 1 through its k neighbours on
+// either side (Lagrange weights on the stamps), and *gain = 1 + the sum of the squared weights
+// (the error's variance over σ² for white noise). False where the neighbours are not all inside
+// [0, n) of the segment with distinct stamps.
+bool HeldOut(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index n, Eigen::Index i,
+             int k, Eigen::Ref<Eigen::RowVectorXd> error, double* gain) {
+  if (i < k || i + k >= n) return false;
+  Eigen::Index neighbours[8];
+  for (int j = 0; j < k; ++j) neighbours[j] = first + i - k + j, neighbours[k + j] = first + i + 1 + j;
+  const double ti = t[first + i];
+  error = z.row(first + i);
+  *gain = 1.0;
+  for (int j = 0; j < 2 * k; ++j) {
+    double weight = 1.0;
+    for (int l = 0; l < 2 * k; ++l) {
+      if (l == j) continue;
+      const double span = t[neighbours[j]] - t[neighbours[l]];
+      if (!(span != 0.0)) return false;
+      weight *= (ti - t[neighbours[l]]) / span;
+    }
+    error -= weight * z.row(neighbours[j]);
+    *gain += weight * weight;
+  }
+  return true;
+}
+
+// The derivative at sample i of the quartic through samples i − 2 .. i + 2 (distinct stamps).
+double QuarticRate(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index i, Eigen::Index c) {
+  double rate = 0.0, own = 0.0;
+  for (Eigen::Index j = i - 2; j <= i + 2; ++j) {
+    if (j == i) continue;
+    own += 1.0 / (t[i] - t[j]);
+    double weight = 1.0 / (t[j] - t[i]);
+    for (Eigen::Index l = i - 2; l <= i + 2; ++l) {
+      if (l != j && l != i) weight *= (t[i] - t[l]) / (t[j] - t[l]);
+    }
+    rate += weight * z(j, c);
+  }
+  return rate + own * z(i, c);
+}
+
 }  // namespace
+
+Eigen::ArrayXXi UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
+                                   Eigen::Index last, const CurveSegment& segment) {
+  const Eigen::Index n = last - first, d = z.cols();
+  const auto count = static_cast<Eigen::Index>(segment.windows.size());
+  Eigen::ArrayXXi stencil = Eigen::ArrayXXi::Zero(count, d);
+  // Per window: the held-out errors' sums of squares of the polynomials through 2, 3 and 4
+  // neighbours on either side (degree 3, 5, 7) at the samples where all exist, their noise gains,
+  // and Σ 1/h² (the 3-point rate's noise).
+  constexpr int kOrders = 3;
+  Eigen::MatrixXd squares[kOrders], gains = Eigen::MatrixXd::Zero(count, kOrders);
+  for (Eigen::MatrixXd& sum : squares) sum = Eigen::MatrixXd::Zero(count, d);
+  Eigen::VectorXd used = Eigen::VectorXd::Zero(count), spacing = Eigen::VectorXd::Zero(count);
+  Eigen::RowVectorXd errors[kOrders];
+  for (Eigen::RowVectorXd& error : errors) error.resize(d);
+  // Evenly spaced stamps (to 1e-9 of the step) take the fixed weights.
+  bool even = n > 1 && t[first + 1] > t[first];
+  for (Eigen::Index i = 1; i < n && even; ++i) {
+    even = std::abs(t[first + i] - t[first + i - 1] - (t[first + 1] - t[first])) <= 1e-9 * (t[first + 1] - t[first]);
+  }
+  Eigen::Index w = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    while (w + 1 < count && t[first + i] >= segment.windows[static_cast<size_t>(w + 1)].core_begin) ++w;
+    double gain[kOrders];
+    bool all = i >= kOrders + 1 && i + kOrders + 1 < n;
+    if (all && even) {  // the same at even spacing, from fixed weights: Δ⁴z/6, Δ⁶z/20, Δ⁸z/70
+      for (Eigen::Index c = 0; c < d; ++c) {
+        const double* y = z.col(c).data() + first + i;
+        for (int o = 0; o < kOrders; ++o) {
+          double e = 0.0;
+          for (int j = -(o + 2); j <= o + 2; ++j) e += kEvenWeights[o][j + o + 2] * y[j];
+          squares[o](w, c) += e * e;
+        }
+      }
+      for (int o = 0; o < kOrders; ++o) gains(w, o) += kEvenGains[o];
+    } else {
+      for (int o = 0; o < kOrders && all; ++o) all = HeldOut(t, z, first, n, i, o + 2, errors[o], &gain[o]);
+      if (!all) continue;
+      for (int o = 0; o < kOrders; ++o) {
+        squares[o].row(w) += errors[o].cwiseAbs2();
+        gains(w, o) += gain[o];
+      }
+    }
+    if (!all) continue;
+    used[w] += 1.0;
+    const double h = 0.5 * (t[first + i + 1] - t[first + i - 1]);
+    spacing[w] += 1.0 / (h * h);
+  }
+  for (Eigen::Index k = 0; k < count; ++k) {
+    const CurveWindow& window = segment.windows[static_cast<size_t>(k)];
+    if (used[k] < kMinHeldOut || window.residual_rms.size() != d || window.degrees.size() != static_cast<size_t>(d)) {
+      continue;
+    }
+    const auto m = static_cast<double>(window.samples);
+    const double span = window.fit_end - window.fit_begin, h = 1.0 / std::sqrt(spacing[k] / used[k]);
+    for (Eigen::Index c = 0; c < d; ++c) {
+      const double p = window.degrees[static_cast<size_t>(c)] + 1.0;
+      if (!(m > p) || !(span > 0.0)) continue;
+      // At even spacing h the held-out errors are Δ⁴z/6, Δ⁶z/20 and Δ⁸z/70: for motion of
+      // frequency ω each order's is u·(6/20)² and u·(20/70)² of the one before, u = (2 sin(ωh/2))²
+      // ≤ 4 (at most 0.36 and 0.33); for white noise 1.19 and 1.14 (the gains' ratios). Only
+      // where both ratios are below 1/2 is the cubic's error motion the samples under-resolve
+      // (not noise), and u gives ω.
+      const double cubic = squares[0](k, c), quintic = squares[1](k, c), septic = squares[2](k, c);
+      if (!(quintic < kUnderResolved * cubic) || !(septic < kUnderResolved * quintic)) continue;
+      const double u = std::min(4.0, quintic / cubic / 0.09), omega_h = 2.0 * std::asin(0.5 * std::sqrt(u));
+      // The degree-7 error less what the motion gives it bounds the noise.
+      const double frequency = omega_h / h, noise = std::max(0.0, septic - 0.0816 * u * quintic) / gains(k, 2);
+      // What the window missed, at least: its generalised cross-validation error m·RSS/(m − p)²
+      // less what the noise gives it, σ²·m/(m − p). Above the 2N/span it resolves, the missed
+      // motion's rate errs by that times the frequency.
+      if (!(frequency > 2.0 * (p - 1.0) / span)) continue;
+      const double missed = m * m * window.residual_rms[c] * window.residual_rms[c] / ((m - p) * (m - p)) -
+                            noise * m / (m - p);
+      // Each local rate's error: its noise σ²·Σw² and its bias at ω, a fraction of the motion's
+      // rate, the motion being 6/u² of the cubic's error. The 3-point rate (central difference):
+      // Σw² = 1/(2h²), fraction 1 − sin(ωh)/ωh; the 5-point one (the quartic's derivative):
+      // Σw² = 130/(144h²), fraction 1 − (8 sin(ωh) − sin(2ωh))/(6ωh).
+      const double motion = std::max(0.0, cubic - noise * gains(k, 0)) / used[k];
+      const double scale = 6.0 / (u * u) * frequency, inverse_h2 = spacing[k] / used[k];
+      const double bias3 = scale * (1.0 - std::sin(omega_h) / omega_h);
+      const double bias5 = scale * (1.0 - (8.0 * std::sin(omega_h) - std::sin(2.0 * omega_h)) / (6.0 * omega_h));
+      // The interpolating cubic spline's slopes (C² at the samples): Σw² = 1.392/h², fraction
+      // 1 − 3 sin(ωh)/(ωh(2 + cos ωh)).
+      const double bias_spline = scale * (1.0 - 3.0 * std::sin(omega_h) / (omega_h * (2.0 + std::cos(omega_h))));
+      const double error3 = noise * 0.5 * inverse_h2 + motion * bias3 * bias3;
+      const double error5 = noise * 130.0 / 144.0 * inverse_h2 + motion * bias5 * bias5;
+      const double error_spline = noise * 1.392 * inverse_h2 + motion * bias_spline * bias_spline;
+      const double best = std::min({error3, error5, error_spline});
+      if (missed > 0.0 && missed * frequency * frequency > best) {
+        stencil(k, c) = best == error_spline ? kSpline : best == error5 ? 5 : 3;
+      }
+    }
+  }
+  return stencil;
+}
+
+bool UnderResolvedAnywhere(const Eigen::VectorXd& t, const Eigen::MatrixXd& z,
+                                       const std::vector<Eigen::Index>& starts, const std::vector<CurveSegment>& segments) {
+  for (size_t k = 0; k + 1 < starts.size() && k < segments.size(); ++k) {
+    if ((UnderResolvedRates(t, z, starts[k], starts[k + 1], segments[k]) > 0).any()) return true;
+  }
+  return false;
+}
 
 std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                 Eigen::Index last, const CurveSegment& segment, const Eigen::MatrixXd& fit_values,
@@ -65,15 +250,26 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> local =
       Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, false);
   const std::vector<CurveWindow>& windows = segment.windows;
+  const Eigen::ArrayXXi stencil = UnderResolvedRates(t, z, first, last, segment);
+  // Samples whose rate is the 5-point one, and the spline's (UnderResolvedRates).
+  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> five =
+      Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, false);
+  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> spline = five;
   size_t w = 0;
   bool any = false;
   for (Eigen::Index i = 0; i < n; ++i) {
     const double ti = t[first + i];
     while (w + 1 < windows.size() && ti >= windows[w + 1].core_begin) ++w;
     const CurveWindow& window = windows[w];
-    if (window.verdict != WindowVerdict::kUnresolved || window.lack_of_fit.size() != d) continue;
+    if (window.lack_of_fit.size() != d) continue;
+    const bool unresolved = window.verdict == WindowVerdict::kUnresolved;
     for (Eigen::Index c = 0; c < d; ++c) {
-      local(i, c) = window.lack_of_fit[c] > lack_of_fit_limit && window.residual_rms[c] >= std::sqrt(2.0) * sigma[c];
+      const int under = stencil(static_cast<Eigen::Index>(w), c);
+      local(i, c) = (unresolved && window.lack_of_fit[c] > lack_of_fit_limit &&
+                     window.residual_rms[c] >= std::sqrt(2.0) * sigma[c]) ||
+                    under > 0;
+      five(i, c) = under == 5;
+      spline(i, c) = under == kSpline;
       any = any || local(i, c);
     }
   }
@@ -87,6 +283,9 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
   const auto usable = UsableSlopes(h, slopes, sigma);
   // The derivative at sample i of the quadratic through it and its neighbours, from usable slopes.
   auto rate = [&](Eigen::Index i, Eigen::Index c) {
+    if (five(i, c) && i >= 2 && i + 2 < n && usable(i - 2, c) && usable(i - 1, c) && usable(i, c) && usable(i + 1, c)) {
+      return QuarticRate(t, z, first + i, c);
+    }
     const bool left = i >= 1 && usable(i - 1, c), right = i + 1 < n && usable(i, c);
     if (left && right) return (h[i] * slopes(i - 1, c) + h[i - 1] * slopes(i, c)) / (h[i - 1] + h[i]);
     if (right) {
@@ -116,11 +315,13 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
     LocalRun run;
     run.values.resize(stop - begin, d);
     run.rates.resize(stop - begin, d);
+    std::vector<Eigen::Index> index;  // the sample of each row
     for (Eigen::Index k = begin; k < stop; ++k) {
       // A sample at the stamp of the one before it adds no interval (the first one stays).
       if (!run.times.empty() && !(t[first + k] > run.times.back())) continue;
       const auto r = static_cast<Eigen::Index>(run.times.size());
       run.times.push_back(t[first + k]);
+      index.push_back(k);
       for (Eigen::Index c = 0; c < d; ++c) {
         if (local(k, c)) {
           run.values(r, c) = z(first + k, c);
@@ -129,6 +330,26 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
           run.values(r, c) = fit_values(first + k, c);
           run.rates(r, c) = fit_rates(first + k, c);
         }
+      }
+    }
+    // Where the spline's slopes were chosen: maximal stretches of inner rows whose slopes on either
+    // side are usable, clamped at the rates of the rows around them.
+    const auto rows = static_cast<Eigen::Index>(run.times.size());
+    for (Eigen::Index c = 0; c < d; ++c) {
+      auto splined = [&](Eigen::Index r) {
+        const Eigen::Index k = index[static_cast<size_t>(r)];
+        return r >= 1 && r + 1 < rows && spline(k, c) && local(k, c) && k >= 1 && usable(k - 1, c) && k + 1 < n &&
+               usable(k, c) && index[static_cast<size_t>(r - 1)] == k - 1 && index[static_cast<size_t>(r + 1)] == k + 1;
+      };
+      for (Eigen::Index r = 1; r + 1 < rows;) {
+        if (!splined(r)) {
+          ++r;
+          continue;
+        }
+        Eigen::Index b = r;
+        while (b + 1 < rows - 1 && splined(b + 1)) ++b;
+        SplineSlopes(run.times, run.values.col(c).head(rows), r, b, run.rates.col(c).head(rows));
+        r = b + 1;
       }
     }
     i = end;
