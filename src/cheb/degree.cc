@@ -84,6 +84,7 @@ Eigen::VectorXd EstimateNoiseSigma(const Eigen::Ref<const Eigen::VectorXd>& t, c
     if (b >= 0 && b < m) cut[static_cast<size_t>(b)] = 1;
   }
   std::vector<std::vector<double>> magnitudes(static_cast<size_t>(d));
+  for (auto& values : magnitudes) values.reserve(static_cast<size_t>(std::max<Eigen::Index>(m - kRun + 1, 0)));
   for (Eigen::Index i = 0; i + kRun <= m; ++i) {
     bool usable = true;
     for (Eigen::Index j = i; j + 1 < i + kRun && usable; ++j) usable = !cut[static_cast<size_t>(j)] && t[j + 1] > t[j];

@@ -29,6 +29,9 @@ constexpr double kRateJumpScore = 3.0;
 // Passes over the slopes, each with the local scale taken again.
 constexpr int kPasses = 8;
 
+// Up to 4 coordinates (FitCurve's), on the stack: the per-slope predictions allocate nothing.
+using Point = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 4, 1>;
+
 class SlopeScan {
  public:
   SlopeScan(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<Eigen::Index>& gaps,
@@ -75,40 +78,52 @@ class SlopeScan {
   // extrapolations cancel to first order, while one side's alone would exceed the local scale of
   // noise-free data and flag every slope next to a jump already found.
   // `disagreement`: how far apart the two sides' predictions are (right − left).
-  std::optional<Eigen::VectorXd> Departure(Eigen::Index j, Eigen::VectorXd* disagreement = nullptr) const {
-    Eigen::VectorXd left(d_), right(d_);
+  std::optional<Point> Departure(Eigen::Index j, Eigen::VectorXd* disagreement = nullptr) const {
+    Point left(d_), right(d_);
     if (!PredictFrom(j, -1, &left) || !PredictFrom(j, 1, &right)) return std::nullopt;
     if (disagreement != nullptr) *disagreement = right - left;
-    return Eigen::VectorXd(slopes_.row(j).transpose() - 0.5 * (left + right));
+    return Point(slopes_.row(j).transpose() - 0.5 * (left + right));
+  }
+
+  // Every slope's departure (rows; NaN where it cannot be told or the slope is not usable), as
+  // Departure gives them now: one pass serves the local scale and the first scores.
+  Eigen::MatrixXd Departures() const {
+    Eigen::MatrixXd departures = Eigen::MatrixXd::Constant(n_, d_, std::numeric_limits<double>::quiet_NaN());
+    for (Eigen::Index j = 0; j < n_; ++j) {
+      if (!Usable(j)) continue;
+      if (const std::optional<Point> e = Departure(j)) departures.row(j) = e->transpose();
+    }
+    return departures;
   }
 
   // The largest departure of slope j in local scales (0 when it cannot be told).
   double Score(Eigen::Index j, const Eigen::MatrixXd& scale, Eigen::VectorXd* departure = nullptr,
                Eigen::VectorXd* disagreement = nullptr) const {
     if (!Usable(j)) return 0.0;
-    const std::optional<Eigen::VectorXd> e = Departure(j, disagreement);
+    const std::optional<Point> e = Departure(j, disagreement);
     if (!e) return 0.0;
     if (departure != nullptr) *departure = *e;
+    return Score(j, *e, scale);
+  }
+  // The same for a departure `e` of slope j already at hand.
+  template <typename Departure>
+  double Score(Eigen::Index j, const Departure& e, const Eigen::MatrixXd& scale) const {
     double score = 0.0;
-    for (Eigen::Index c = 0; c < d_; ++c) {
-      score = std::max(score, std::abs((*e)[c]) / LocalScale(j, c, scale));
-    }
+    for (Eigen::Index c = 0; c < d_; ++c) score = std::max(score, std::abs(e[c]) / LocalScale(j, c, scale));
     return score;
   }
 
   // The local scale per block of slopes and coordinate: 1.4826 · median |departure| over the block
-  // and its two neighbours' medians (the largest), from the departures before anything is found.
-  Eigen::MatrixXd Scales() const {
+  // and its two neighbours' medians (the largest), from the pass's departures (Departures).
+  Eigen::MatrixXd Scales(const Eigen::MatrixXd& departures) const {
     const Eigen::Index blocks = (n_ + kBlock - 1) / kBlock;
     Eigen::MatrixXd median = Eigen::MatrixXd::Zero(blocks, d_);
     std::vector<std::vector<double>> values(static_cast<size_t>(d_));
     for (Eigen::Index b = 0; b < blocks; ++b) {
       for (auto& v : values) v.clear();
       for (Eigen::Index j = b * kBlock; j < std::min(n_, (b + 1) * kBlock); ++j) {
-        if (!Usable(j)) continue;
-        const std::optional<Eigen::VectorXd> e = Departure(j);
-        if (!e) continue;
-        for (Eigen::Index c = 0; c < d_; ++c) values[static_cast<size_t>(c)].push_back(std::abs((*e)[c]));
+        if (std::isnan(departures(j, 0))) continue;
+        for (Eigen::Index c = 0; c < d_; ++c) values[static_cast<size_t>(c)].push_back(std::abs(departures(j, c)));
       }
       for (Eigen::Index c = 0; c < d_; ++c) {
         std::vector<double>& v = values[static_cast<size_t>(c)];
@@ -179,9 +194,9 @@ class SlopeScan {
   // not crossing a cut, evaluated at slope j's time; false with fewer than kSide / 2 slopes (a line
   // from two or three slopes extrapolates their noise several times over: next to the ends of the
   // data it flagged plain noise as a jump and cut off the first few samples).
-  bool PredictFrom(Eigen::Index j, int direction, Eigen::VectorXd* prediction) const {
+  bool PredictFrom(Eigen::Index j, int direction, Point* prediction) const {
     double s0 = 0, s1 = 0, s2 = 0;
-    Eigen::VectorXd b0 = Eigen::VectorXd::Zero(d_), b1 = Eigen::VectorXd::Zero(d_);
+    Point b0 = Point::Zero(d_), b1 = Point::Zero(d_);
     int count = 0;
     for (Eigen::Index i = j + direction, step = 1; i >= 0 && i < n_ && count < kSide && step <= 3 * kSide;
          i += direction, ++step) {
@@ -286,10 +301,12 @@ Jumps FindJumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
   // The local scale is taken again each pass, without the slopes found so far: dense defects (a
   // correction every few samples) inflate the first pass's scale and hide all but the largest.
   for (int pass = 0; pass < kPasses; ++pass) {
-    const Eigen::MatrixXd scale = scan.Scales();
+    const Eigen::MatrixXd departures = scan.Departures();
+    const Eigen::MatrixXd scale = scan.Scales(departures);
     std::vector<std::pair<double, Eigen::Index>> candidates;
     for (Eigen::Index j = 0; j < n; ++j) {
-      const double score = scan.Score(j, scale);
+      if (std::isnan(departures(j, 0))) continue;
+      const double score = scan.Score(j, departures.row(j), scale);
       if (score > kThreshold) candidates.emplace_back(score, j);
     }
     if (candidates.empty()) break;
