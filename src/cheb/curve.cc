@@ -676,8 +676,10 @@ std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::Ve
     std::array<std::optional<HalfFit>, 2> halves;
     if (window && may_split && !end_piece &&
         SplitPredictsBetter(fitter, *window, held_out, segment, options, undecided, &halves)) {
+      // Missed motion when its residual said so; a window split because its coefficients could
+      // not show it resolved (undecided) is only too long for its top degree.
+      missed = window->lack_of_fit.maxCoeff() > kSplitScore;
       window.reset();
-      missed = true;
     }
     if (!window) {
       const double middle = 0.5 * (a + b);
