@@ -18,6 +18,10 @@ from support import DATA, main_needing, run_cli
 
 EUROC = os.path.join(DATA, "ov_data", "euroc_mav")
 FILES = ["MH_05_difficult.csv", "V1_02_medium.csv", "V2_02_medium.csv", "V1_01_easy.csv"]
+# (file, every k-th row): the native files (V1_01 is shared at 20 Hz), and MH_05 thinned to 20 Hz,
+# which ends in a landing 0.2 s before its last sample (its end cap once kept the unresolved end
+# window's polynomial, 0.68 m/s off at the last sample: 17.3 mm/s RMS against the median's 13.0).
+CASES = [(name, 1) for name in FILES] + [("MH_05_difficult.csv", 10)]
 
 
 def central_differences(t, p):
@@ -43,14 +47,15 @@ def rms_and_median(estimate, truth):
 
 class EurocVelocityTest(unittest.TestCase):
     def test_agrees_with_euroc_better_than_the_median_of_five_central_differences(self):
-        for name in FILES:
-            with self.subTest(name):
+        for name, every in CASES:
+            with self.subTest(f"{name} every {every}"):
                 gt = cheval.read(os.path.join(EUROC, name))
-                v = cheval.velocity({"stamps": gt.stamps, "positions": gt.positions})["velocities"]
-                t = (gt.stamps - gt.stamps[0]) * 1e-9
-                robust = median_of_five(central_differences(t, gt.positions))
-                rms, median = rms_and_median(v, gt.velocities)
-                rms5, median5 = rms_and_median(robust, gt.velocities)
+                stamps, positions, velocities = gt.stamps[::every], gt.positions[::every], gt.velocities[::every]
+                v = cheval.velocity({"stamps": stamps, "positions": positions})["velocities"]
+                t = (stamps - stamps[0]) * 1e-9
+                robust = median_of_five(central_differences(t, positions))
+                rms, median = rms_and_median(v, velocities)
+                rms5, median5 = rms_and_median(robust, velocities)
                 self.assertLess(rms, rms5, f"{name}: RMS {rms:.5f} m/s, median of five {rms5:.5f}")
                 self.assertLess(median, median5, f"{name}: median {median:.5f} m/s, median of five {median5:.5f}")
 

@@ -260,7 +260,10 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
   for (Eigen::Index i = 0; i < n; ++i) {
     const double ti = t[first + i];
     while (w + 1 < windows.size() && ti >= windows[w + 1].core_begin) ++w;
-    const CurveWindow& window = windows[w];
+    // An end cap (no residual test of its own) takes the verdict of the end window it was cut
+    // from: its samples are that window's, and where no cap fit helps it is that window's polynomial.
+    const bool cap = windows[w].lack_of_fit.size() != d && windows.size() > 1 && (w == 0 || w + 1 == windows.size());
+    const CurveWindow& window = cap ? windows[w == 0 ? 1 : w - 1] : windows[w];
     if (window.lack_of_fit.size() != d) continue;
     const bool unresolved = window.verdict == WindowVerdict::kUnresolved;
     for (Eigen::Index c = 0; c < d; ++c) {
