@@ -268,9 +268,12 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
     const bool unresolved = window.verdict == WindowVerdict::kUnresolved;
     for (Eigen::Index c = 0; c < d; ++c) {
       const int under = stencil(static_cast<Eigen::Index>(w), c);
+      // An unresolved window that interpolates its samples (no freedom left for the residual test)
+      // shows nothing better than the samples' own interpolant, whose rate is far better conditioned.
+      const bool interpolates = window.samples - window.degrees[static_cast<size_t>(c)] - 1 <= 0;
       local(i, c) = (unresolved && window.lack_of_fit[c] > lack_of_fit_limit &&
                      window.residual_rms[c] >= std::sqrt(2.0) * sigma[c]) ||
-                    under > 0;
+                    (unresolved && interpolates) || under > 0;
       five(i, c) = under == 5;
       spline(i, c) = under == kSpline;
       any = any || local(i, c);
