@@ -21,7 +21,8 @@ namespace cheval::cheb::internal {
 /// pilot's own σ²|w_P|² is common to every candidate and cancels), and so are the windows' rates
 /// (their weights from each core window's normal matrix). The best candidate replaces the
 /// windows' rate in that coordinate when its score, plus twice the pilot's squared bias
-/// (estimated against degree 7 over 11 samples), is below the windows', its gain is at least 2
+/// (estimated against degree 7 over 11 samples, less 2 standard errors of that estimate from
+/// the means of 53-sample blocks), is below the windows', its gain is at least 2
 /// standard errors (from the means of 53-sample blocks; stretches of at least 4 blocks), and the
 /// windows' rates differ from the pilot's by at least a quarter of what σ implies (else σ
 /// overstates the noise and the windows are kept; σ² itself is the smaller of the data's and
