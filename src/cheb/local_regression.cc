@@ -315,6 +315,12 @@ struct StretchScores {
 
 }  // namespace
 
+bool RegressionMayGain(const CurveWindow& window) {
+  if (window.missed_motion) return true;
+  const int top = *std::max_element(window.degrees.begin(), window.degrees.end());
+  return window.samples < (2 * kHalves.back() + 1) * static_cast<Eigen::Index>(top + 1);
+}
+
 std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                           Eigen::Index last, const CurveSegment& segment,
                                           const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
@@ -330,7 +336,7 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
   for (Eigen::Index i = 0; i < n; ++i) {
     const double ti = t[first + i];
     while (w + 1 < windows.size() && ti >= windows[w + 1].core_begin) ++w;
-    if (w == 0 || w + 1 == windows.size() || !windows[w].missed_motion) continue;
+    if (w == 0 || w + 1 == windows.size() || !RegressionMayGain(windows[w])) continue;
     const bool inside = std::any_of(taken.begin(), taken.end(), [ti](const LocalRun& run) {
       return ti >= run.times.front() && ti <= run.times.back();
     });

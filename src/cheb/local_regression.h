@@ -11,8 +11,15 @@
 
 namespace cheval::cheb::internal {
 
+/// Whether the local regression is tried in a window's core: the window was split for missed
+/// motion, or it spends a coefficient on fewer samples than the widest candidate (53) spans, so
+/// its rate is as local as theirs. A window with more samples per coefficient is smoother than
+/// any candidate and has resolved the motion (it passed the residual and coefficient tests), and
+/// scoring its stretch would cost ~0.2 s of CPU on a 100k-sample drone flight for nothing.
+bool RegressionMayGain(const CurveWindow& window);
+
 /// The local-regression runs of one segment. Candidates are stretches of consecutive samples in
-/// the cores of windows split for missed motion (CurveWindow::missed_motion), the segment's first
+/// the cores of windows where RegressionMayGain, the segment's first
 /// and last window left out (the end caps' variance is not the window's) and samples inside
 /// `taken` (runs already made) too. Per stretch and coordinate, each local polynomial regression
 /// of odd degree 1–7 over 7–53 samples centred on each sample (shifted to stay inside the
