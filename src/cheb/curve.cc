@@ -605,11 +605,12 @@ bool SplitPredictsBetter(const WindowFitter& fitter, const CurveWindow& window, 
   return error.cwiseQuotient(held_out).mean() < 1.0;
 }
 
-// Whether some window of the segments is a piece of one split for missed motion.
+// Whether the local regression may gain in some window of the segments (not a segment's first
+// or last window: their rate is the end caps').
 bool MissedMotion(const std::vector<CurveSegment>& segments) {
   for (const CurveSegment& segment : segments) {
-    for (const CurveWindow& window : segment.windows) {
-      if (window.missed_motion) return true;
+    for (size_t k = 1; k + 1 < segment.windows.size(); ++k) {
+      if (internal::RegressionMayGain(segment.windows[k])) return true;
     }
   }
   return false;

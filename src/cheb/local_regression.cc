@@ -235,10 +235,10 @@ class WindowWeights {
 
 // Sums over a stretch of samples for choosing between the candidates and the windows: squared
 // rate differences from the pilot and weight products with it, per candidate (rows) and
-// coordinate; the same for the windows; the pilot's bias against the reference; and the
-// per-sample gains over the windows, D = (v_a − v_P)² − (v_W − v_P)² and P = w_a·w_P − w_W·w_P,
-// summed per block of kBlock samples (the gains are correlated over about a candidate's width;
-// the blocks' means scatter like independent draws).
+// coordinate; the same for the windows; and, summed per block of kBlock samples (they are
+// correlated over about a candidate's width; the blocks' means scatter like independent draws),
+// the per-sample gains over the windows, D = (v_a − v_P)² − (v_W − v_P)² and P = w_a·w_P − w_W·w_P,
+// and the pilot's squared rate differences from the reference and their noise factor |w_P − w_R|².
 struct StretchScores {
   StretchScores(Eigen::Index count, Eigen::Index d, Eigen::Index samples)
       : length(samples),
@@ -248,10 +248,26 @@ struct StretchScores {
         window_differences(Eigen::VectorXd::Zero(d)),
         window_products(Eigen::VectorXd::Zero(d)),
         window_spread(Eigen::VectorXd::Zero(d)),
-        bias_differences(Eigen::VectorXd::Zero(d)),
         usable(static_cast<size_t>(count), 1),
         block_gains(static_cast<size_t>(blocks), Eigen::MatrixXd::Zero(count, d)),
-        block_products(static_cast<size_t>(blocks), Eigen::MatrixXd::Zero(count, d)) {}
+        block_products(static_cast<size_t>(blocks), Eigen::MatrixXd::Zero(count, d)),
+        block_bias_differences(static_cast<size_t>(blocks), Eigen::VectorXd::Zero(d)),
+        block_bias_variance(static_cast<size_t>(blocks), 0.0) {}
+
+  // The mean per sample of a quantity summed per block (`block_sum(b)`) and its standard error
+  // from the scatter of the blocks' means.
+  template <class BlockSum>
+  std::pair<double, double> MeanAndError(BlockSum&& block_sum) const {
+    double sum = 0.0, sum_squares = 0.0;
+    for (size_t b = 0; b < block_gains.size(); ++b) {
+      const double size = b + 1 == block_gains.size() ? static_cast<double>(length - static_cast<Eigen::Index>(b) * kBlock)
+                                                      : static_cast<double>(kBlock);
+      const double total = block_sum(b);
+      sum += total, sum_squares += (total / size) * (total / size);
+    }
+    const double mean = sum / static_cast<double>(length), count = static_cast<double>(blocks);
+    return {mean, std::sqrt(std::max(0.0, sum_squares / count - mean * mean) / (count - 1.0))};
+  }
 
   // The candidate that replaces the windows in coordinate c (noise σ), or -1.
   int Choose(Eigen::Index c, double sigma) const {
@@ -273,31 +289,37 @@ struct StretchScores {
         chosen = static_cast<int>(a);
       }
     }
-    const double bias = std::max(0.0, bias_differences[c] - variance * bias_variance);
+    // The pilot's squared bias (its rate's mean squared difference from the reference's less
+    // the noise's share) counts as far as it stands out of its own scatter: that estimate
+    // subtracts a noise term some 10x the bias it leaves, and a per-cent error of σ² or the
+    // scatter of the differences would otherwise veto every candidate at random.
+    const auto [bias_mean, bias_error] = MeanAndError(
+        [&](size_t b) { return block_bias_differences[b][c] - variance * block_bias_variance[b]; });
+    const double bias = static_cast<double>(length) * std::max(0.0, bias_mean - kSignificance * bias_error);
     const double windows_score = window_differences[c] + 2.0 * variance * window_products[c];
     if (chosen < 0 || !(best + 2.0 * bias < windows_score)) return -1;
     // The gain must stand out of its own scatter: 2 standard errors of the mean of the blocks'.
-    double sum = 0.0, sum_squares = 0.0;
-    for (size_t b = 0; b < block_gains.size(); ++b) {
-      const double size = b + 1 == block_gains.size() ? static_cast<double>(length - static_cast<Eigen::Index>(b) * kBlock)
-                                                      : static_cast<double>(kBlock);
-      const double gain = (block_gains[b](chosen, c) + 2.0 * variance * block_products[b](chosen, c)) / size;
-      sum += gain * size, sum_squares += gain * gain;
-    }
-    const double mean = sum / static_cast<double>(length), count = static_cast<double>(blocks);
-    const double error = std::sqrt(std::max(0.0, sum_squares / count - mean * mean) / (count - 1.0));
+    const auto [mean, error] = MeanAndError(
+        [&](size_t b) { return block_gains[b](chosen, c) + 2.0 * variance * block_products[b](chosen, c); });
     return mean < -kSignificance * error ? chosen : -1;
   }
 
   Eigen::Index length, blocks;
   Eigen::MatrixXd differences;
-  Eigen::VectorXd products, window_differences, window_products, window_spread, bias_differences;
-  double bias_variance = 0.0;
+  Eigen::VectorXd products, window_differences, window_products, window_spread;
   std::vector<char> usable;
   std::vector<Eigen::MatrixXd> block_gains, block_products;
+  std::vector<Eigen::VectorXd> block_bias_differences;
+  std::vector<double> block_bias_variance;
 };
 
 }  // namespace
+
+bool RegressionMayGain(const CurveWindow& window) {
+  if (window.missed_motion) return true;
+  const int top = *std::max_element(window.degrees.begin(), window.degrees.end());
+  return window.samples < (2 * kHalves.back() + 1) * static_cast<Eigen::Index>(top + 1);
+}
 
 std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                           Eigen::Index last, const CurveSegment& segment,
@@ -314,7 +336,7 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
   for (Eigen::Index i = 0; i < n; ++i) {
     const double ti = t[first + i];
     while (w + 1 < windows.size() && ti >= windows[w + 1].core_begin) ++w;
-    if (w == 0 || w + 1 == windows.size() || !windows[w].missed_motion) continue;
+    if (w == 0 || w + 1 == windows.size() || !RegressionMayGain(windows[w])) continue;
     const bool inside = std::any_of(taken.begin(), taken.end(), [ti](const LocalRun& run) {
       return ti >= run.times.front() && ti <= run.times.back();
     });
@@ -363,8 +385,10 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
       const Regression reference = fits.Fit(bias_h, kMaxDegree);
       if (!pilot.ok || !reference.ok) return runs;
       const double ti = ts[i];
-      scores.bias_differences += (pilot.rate - reference.rate).cwiseAbs2();
-      scores.bias_variance += WeightNorm(pilot) - 2.0 * WeightProduct(ts, ti, pilot, reference) + WeightNorm(reference);
+      const auto block = static_cast<size_t>(std::min(scores.blocks - 1, static_cast<Eigen::Index>(q) / kBlock));
+      scores.block_bias_differences[block] += (pilot.rate - reference.rate).cwiseAbs2();
+      scores.block_bias_variance[block] +=
+          WeightNorm(pilot) - 2.0 * WeightProduct(ts, ti, pilot, reference) + WeightNorm(reference);
       const auto k = static_cast<size_t>(owner[static_cast<size_t>(i)]);
       if (!window_weights[k]) window_weights[k].emplace(t, z, windows[k]);
       const Eigen::VectorXd window_difference = (fit_rates.row(first + i).transpose() - pilot.rate).cwiseAbs2();
@@ -372,7 +396,6 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
       scores.window_differences += window_difference;
       scores.window_products += product;
       scores.window_spread += ((norm - 2.0 * product).array() + WeightNorm(pilot)).matrix();
-      const auto block = static_cast<size_t>(std::min(scores.blocks - 1, static_cast<Eigen::Index>(q) / kBlock));
       for (Eigen::Index a = 0; a < count; ++a) {
         const auto [h, degree] = candidates[static_cast<size_t>(a)];
         const Regression r = fits.Fit(h, degree);

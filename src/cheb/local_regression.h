@@ -11,8 +11,15 @@
 
 namespace cheval::cheb::internal {
 
+/// Whether the local regression is tried in a window's core: the window was split for missed
+/// motion, or it spends a coefficient on fewer samples than the widest candidate (53) spans, so
+/// its rate is as local as theirs. A window with more samples per coefficient is smoother than
+/// any candidate and has resolved the motion (it passed the residual and coefficient tests), and
+/// scoring its stretch would cost ~0.2 s of CPU on a 100k-sample drone flight for nothing.
+bool RegressionMayGain(const CurveWindow& window);
+
 /// The local-regression runs of one segment. Candidates are stretches of consecutive samples in
-/// the cores of windows split for missed motion (CurveWindow::missed_motion), the segment's first
+/// the cores of windows where RegressionMayGain, the segment's first
 /// and last window left out (the end caps' variance is not the window's) and samples inside
 /// `taken` (runs already made) too. Per stretch and coordinate, each local polynomial regression
 /// of odd degree 1–7 over 7–53 samples centred on each sample (shifted to stay inside the
@@ -21,7 +28,8 @@ namespace cheval::cheb::internal {
 /// pilot's own σ²|w_P|² is common to every candidate and cancels), and so are the windows' rates
 /// (their weights from each core window's normal matrix). The best candidate replaces the
 /// windows' rate in that coordinate when its score, plus twice the pilot's squared bias
-/// (estimated against degree 7 over 11 samples), is below the windows', its gain is at least 2
+/// (estimated against degree 7 over 11 samples, less 2 standard errors of that estimate from
+/// the means of 53-sample blocks), is below the windows', its gain is at least 2
 /// standard errors (from the means of 53-sample blocks; stretches of at least 4 blocks), and the
 /// windows' rates differ from the pilot's by at least a quarter of what σ implies (else σ
 /// overstates the noise and the windows are kept; σ² itself is the smaller of the data's and
