@@ -607,7 +607,7 @@ bool SplitPredictsBetter(const WindowFitter& fitter, const CurveWindow& window, 
 
 // Whether the local regression may gain in some window of the segments (not a segment's first
 // or last window: their rate is the end caps').
-bool MissedMotion(const std::vector<CurveSegment>& segments) {
+bool RegressionMayGainSomewhere(const std::vector<CurveSegment>& segments) {
   for (const CurveSegment& segment : segments) {
     for (size_t k = 1; k + 1 < segment.windows.size(); ++k) {
       if (internal::RegressionMayGain(segment.windows[k])) return true;
@@ -1008,7 +1008,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   }
   // Where windows were split for missed motion, a local polynomial regression where it predicts
   // the rate better (docs/velocity.md, "Local regression").
-  if (options.lack_of_fit && options.local_regression && adaptive && MissedMotion(curve.segments_)) {
+  if (options.lack_of_fit && options.local_regression && adaptive && RegressionMayGainSomewhere(curve.segments_)) {
     Eigen::MatrixXd fit_values, fit_rates;
     curve.EvaluateMany(sorted, 1, &fit_values, &fit_rates);
     for (Eigen::Index i = 0; i < fitted_count; ++i) {  // the fitted values without the steps, as z

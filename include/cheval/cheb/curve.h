@@ -83,8 +83,9 @@ struct CurveOptions {
   /// judges by the coefficients alone (compression does: on nearly
   /// noise-free ground truth the residual test asks for windows that store more than the samples).
   bool lack_of_fit = true;
-  /// Where windows were split for missed motion (CurveWindow::missed_motion; not the end windows),
-  /// a local polynomial regression per coordinate takes over the rate when its velocity error,
+  /// Where windows were split for missed motion (CurveWindow::missed_motion) or spend a coefficient
+  /// on fewer samples than the widest candidate spans (53; not the end windows), a local
+  /// polynomial regression per coordinate takes over the rate when its velocity error,
   /// estimated against a low-bias pilot, is below the windows' (docs/velocity.md, "Local
   /// regression"). Needs `lack_of_fit` and an adaptive fit. The angular fit turns it off: the
   /// charts' noise varies along them, and the choice relies on one σ.
