@@ -993,16 +993,24 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   }
 
   // Where windows clearly missed motion, the samples' own local interpolant (docs/velocity.md).
-  if (options.lack_of_fit && adaptive &&
-      (curve.unresolved_windows() > 0 || internal::UnderResolvedAnywhere(t, z, starts, curve.segments_))) {
+  std::vector<Eigen::ArrayXXi> under_resolved;  // per segment, UnderResolvedRates
+  bool any_under_resolved = false;
+  if (options.lack_of_fit && adaptive) {
+    for (size_t k = 0; k + 1 < starts.size(); ++k) {
+      under_resolved.push_back(internal::UnderResolvedRates(t, z, starts[k], starts[k + 1], curve.segments_[k]));
+      any_under_resolved = any_under_resolved || (under_resolved.back() > 0).any();
+    }
+  }
+  if (options.lack_of_fit && adaptive && (curve.unresolved_windows() > 0 || any_under_resolved)) {
     Eigen::MatrixXd fit_values, fit_rates;
     curve.EvaluateMany(sorted, 1, &fit_values, &fit_rates);
     for (Eigen::Index i = 0; i < fitted_count; ++i) {  // the fitted values without the steps, as z
       if (const Eigen::Index k = curve.StepsBefore(t[i]); k > 0) fit_values.row(i) -= curve.step_offsets_.row(k - 1);
     }
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
-      std::vector<LocalRun> runs = internal::LocalRuns(t, z, starts[k], starts[k + 1], curve.segments_[k], fit_values,
-                                                       fit_rates, curve.noise_sigma_, kLackOfFitLimit);
+      std::vector<LocalRun> runs = internal::LocalRuns(t, z, starts[k], starts[k + 1], curve.segments_[k],
+                                                       under_resolved[k], fit_values, fit_rates, curve.noise_sigma_,
+                                                       kLackOfFitLimit);
       std::move(runs.begin(), runs.end(), std::back_inserter(curve.local_runs_));
     }
   }

@@ -232,17 +232,10 @@ Eigen::ArrayXXi UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::Matrix
   return stencil;
 }
 
-bool UnderResolvedAnywhere(const Eigen::VectorXd& t, const Eigen::MatrixXd& z,
-                                       const std::vector<Eigen::Index>& starts, const std::vector<CurveSegment>& segments) {
-  for (size_t k = 0; k + 1 < starts.size() && k < segments.size(); ++k) {
-    if ((UnderResolvedRates(t, z, starts[k], starts[k + 1], segments[k]) > 0).any()) return true;
-  }
-  return false;
-}
-
 std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
-                                Eigen::Index last, const CurveSegment& segment, const Eigen::MatrixXd& fit_values,
-                                const Eigen::MatrixXd& fit_rates, const Eigen::VectorXd& sigma, double lack_of_fit_limit) {
+                                Eigen::Index last, const CurveSegment& segment, const Eigen::ArrayXXi& under_resolved,
+                                const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
+                                const Eigen::VectorXd& sigma, double lack_of_fit_limit) {
   std::vector<LocalRun> runs;
   const Eigen::Index n = last - first, d = z.cols();
   if (n < 3 || segment.windows.empty()) return runs;
@@ -250,7 +243,6 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> local =
       Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, false);
   const std::vector<CurveWindow>& windows = segment.windows;
-  const Eigen::ArrayXXi stencil = UnderResolvedRates(t, z, first, last, segment);
   // Samples whose rate is the 5-point one, and the spline's (UnderResolvedRates).
   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> five =
       Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, false);
@@ -267,7 +259,7 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
     if (window.lack_of_fit.size() != d) continue;
     const bool unresolved = window.verdict == WindowVerdict::kUnresolved;
     for (Eigen::Index c = 0; c < d; ++c) {
-      const int under = stencil(static_cast<Eigen::Index>(w), c);
+      const int under = under_resolved(static_cast<Eigen::Index>(w), c);
       // An unresolved window that interpolates its samples (no freedom left for the residual test)
       // shows nothing better than the samples' own interpolant, whose rate is far better conditioned.
       const bool interpolates = window.samples - window.degrees[static_cast<size_t>(c)] - 1 <= 0;

@@ -25,11 +25,6 @@ namespace cheval::cheb::internal {
 Eigen::ArrayXXi UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                    Eigen::Index last, const CurveSegment& segment);
 
-/// Whether UnderResolvedRates finds some window and coordinate of the segments, whose samples are
-/// [starts[k], starts[k + 1]).
-bool UnderResolvedAnywhere(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<Eigen::Index>& starts,
-                           const std::vector<CurveSegment>& segments);
-
 /// The local runs of one segment. A sample is local in coordinate c when it lies in the core of
 /// a window accepted unresolved whose residual in c is clearly above the noise (the lack-of-fit
 /// score above its limit and the residual RMS at least sqrt(2)·σ: the missed motion is at least as
@@ -48,10 +43,11 @@ bool UnderResolvedAnywhere(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, c
 /// filtered ground truth) and is not used.
 ///
 /// `t` (sorted, s) and `z` (m x d, steps taken out) are the curve's fitted samples, [first, last)
-/// the segment's, `fit_values` and `fit_rates` (m x d) the segment's fit at them, `sigma` the
-/// noise per coordinate.
+/// the segment's, `under_resolved` its UnderResolvedRates, `fit_values` and `fit_rates` (m x d)
+/// the segment's fit at them, `sigma` the noise per coordinate.
 std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
-                                Eigen::Index last, const CurveSegment& segment, const Eigen::MatrixXd& fit_values,
-                                const Eigen::MatrixXd& fit_rates, const Eigen::VectorXd& sigma, double lack_of_fit_limit);
+                                Eigen::Index last, const CurveSegment& segment, const Eigen::ArrayXXi& under_resolved,
+                                const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
+                                const Eigen::VectorXd& sigma, double lack_of_fit_limit);
 
 }  // namespace cheval::cheb::internal
