@@ -618,6 +618,16 @@ bool RegressionMayGainSomewhere(const std::vector<CurveSegment>& segments) {
 
 int MaxDegree(const CurveWindow& window) { return *std::max_element(window.degrees.begin(), window.degrees.end()); }
 
+// The samples of sorted times t in [a, b].
+Eigen::Index SamplesIn(const Eigen::VectorXd& t, double a, double b) {
+  return std::upper_bound(t.data(), t.data() + t.size(), b) - std::lower_bound(t.data(), t.data() + t.size(), a);
+}
+
+// The fewest samples an end window's core needs to be halved further (RefineEnds).
+Eigen::Index EndWindowMinimum(const CurveOptions& options) {
+  return 2 * std::max<Eigen::Index>(options.min_window_samples, kMinEndWindowSamples);
+}
+
 // Fits cores [a, b] of a segment adaptively: a core is halved until its series resolves or it
 // gets too small to split. Windows come out in time order.
 std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::VectorXd& t, const CurveSegment& segment,
@@ -632,13 +642,12 @@ std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::Ve
   };
   std::vector<Core> stack;
   stack.push_back({a0, b0});
-  const Eigen::Index end_minimum = 2 * std::max<Eigen::Index>(options.min_window_samples, kMinEndWindowSamples);
+  const Eigen::Index end_minimum = EndWindowMinimum(options);
   const bool refine_ends = options.end_degree > 0 && options.degree_method == DegreeMethod::kCrossValidation;
   while (!stack.empty()) {
     auto [a, b, piece, end_piece, fitted] = std::move(stack.back());
     stack.pop_back();
-    const auto inside =
-        std::upper_bound(t.data(), t.data() + t.size(), b) - std::lower_bound(t.data(), t.data() + t.size(), a);
+    const Eigen::Index inside = SamplesIn(t, a, b);
     const bool may_split = inside >= 2 * options.min_window_samples;
     // A window at an end of its segment whose degree exceeds end_degree is cut by RefineEnds when
     // it is accepted and split when it is not. When that degree is certain, it is cut here unfitted,
@@ -705,15 +714,14 @@ std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::Ve
 void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegment& segment,
                 const CurveOptions& options) {
   if (options.end_degree <= 0) return;
-  auto samples_in = [&t](double a, double b) {
-    return std::upper_bound(t.data(), t.data() + t.size(), b) - std::lower_bound(t.data(), t.data() + t.size(), a);
-  };
+  auto samples_in = [&t](double a, double b) { return SamplesIn(t, a, b); };
+  const Eigen::Index minimum = EndWindowMinimum(options);
   for (const bool front : {true, false}) {
     while (true) {
       auto& windows = segment.windows;
       const CurveWindow& end = front ? windows.front() : windows.back();
       if (MaxDegree(end) <= options.end_degree ||
-          samples_in(end.core_begin, end.core_end) < 2 * std::max<Eigen::Index>(options.min_window_samples, kMinEndWindowSamples)) {
+          samples_in(end.core_begin, end.core_end) < minimum) {
         break;
       }
       // Halving one step at a time fits every outer half on the way and drops all but the last.
@@ -726,7 +734,6 @@ void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegme
       // follow the length; standardChop's jump to the noise plateau and do not, so with it the
       // end window is halved one step at a time.
       const double a = end.core_begin, b = end.core_end;
-      const Eigen::Index minimum = 2 * std::max<Eigen::Index>(options.min_window_samples, kMinEndWindowSamples);
       const bool predict = options.degree_method == DegreeMethod::kCrossValidation;
       std::vector<double> cuts{front ? b : a};  // from the inside out
       for (double degree = MaxDegree(end); degree > options.end_degree && (predict || cuts.size() < 2); degree *= 0.5) {
