@@ -154,7 +154,8 @@ class WindowFitter {
     bool resolved = ChopDegrees(high, m, &window.degrees);
     // The chop looks for a plateau by shape, which a short noisy window can hide: when the top third
     // of the coefficients is statistically pure noise, the window is resolved anyway.
-    if (!resolved) resolved = TailIsNoise(high, *cholesky);
+    const Eigen::VectorXd sigma = WindowSigma(tw, zw, false);
+    if (!resolved) resolved = TailIsNoise(high, *cholesky, sigma);
     if (held_out != nullptr) held_out->resize(0);
     // No plateau and a tail above the noise say that the window *may* miss motion above its top
     // degree, not that it does: at 2 mm of noise a 190-sample window of a legged gait has such a
@@ -179,7 +180,6 @@ class WindowFitter {
     // fails at the chosen degree takes the lowest degree of the grid that passes, if any.
     window.series.interval = interval;
     SetDegrees(*cholesky, probe, &window);
-    const Eigen::VectorXd sigma = WindowSigma(tw, zw, false);
     bool consistent = LackOfFit(tw, zw, sigma, &window) || !options_.lack_of_fit;
     if (!consistent) {
       const Centred centred = Centre(probe, zw);
@@ -230,9 +230,9 @@ class WindowFitter {
       if (!(cholesky.Condition(top) <= kMaxGramCondition)) return false;
       const Eigen::MatrixXd high = cholesky.Solve(top, normal.rhs);
       std::vector<int> degrees(static_cast<size_t>(zw.cols()));
-      if (!ChopDegrees(high, span.count, &degrees) && !TailIsNoise(high, cholesky)) return false;
-      const Centred centred = Centre(normal, zw);
       const Eigen::VectorXd sigma = WindowSigma(tw, zw, false);
+      if (!ChopDegrees(high, span.count, &degrees) && !TailIsNoise(high, cholesky, sigma)) return false;
+      const Centred centred = Centre(normal, zw);
       for (Eigen::Index c = 0; c < zw.cols(); ++c) {
         if (!(centred.LackOfFit(cholesky, top, c, span.count, sigma[c]) <= kSplitScore)) return false;
       }
@@ -349,9 +349,10 @@ class WindowFitter {
   // Whether the top third of a probe's coefficients ((top + 1) x d) is consistent with white noise
   // of the estimated σ in every coordinate: with σ_k = σ·sqrt((G⁻¹)_kk) the standard deviation of
   // coefficient k, Σ (c_k/σ_k)² over the n tail coefficients is χ²(n) for pure noise; the tail is
-  // noise when it stays below n + 4·sqrt(2n) (about 4 standard deviations of χ²(n)). Needs a
-  // tail of at least 8 coefficients and σ > 0 (noise-free data are left to the chop).
-  bool TailIsNoise(const Eigen::MatrixXd& high, const NestedCholesky& cholesky) const {
+  // noise when it stays below n + 4·sqrt(2n) (about 4 standard deviations of χ²(n)). `sigma` is the
+  // window's (WindowSigma: floored at the values' rounding level, which exact data's coefficients
+  // reach). Needs a tail of at least 8 coefficients.
+  static bool TailIsNoise(const Eigen::MatrixXd& high, const NestedCholesky& cholesky, const Eigen::VectorXd& sigma) {
     const Eigen::Index top = high.rows() - 1, n = (top + 1) / 3;
     if (n < 8) return false;
     const Eigen::Index first = top + 1 - n;
@@ -359,10 +360,10 @@ class WindowFitter {
         cholesky.VarianceFactors(static_cast<int>(top), static_cast<int>(first));
     const double limit = static_cast<double>(n) + 4.0 * std::sqrt(2.0 * static_cast<double>(n));
     for (Eigen::Index c = 0; c < high.cols(); ++c) {
-      if (!(sigma_[c] > 0.0)) return false;
+      if (!(sigma[c] > 0.0)) return false;
       double chi2 = 0.0;
       for (Eigen::Index k = first; k <= top; ++k) {
-        chi2 += high(k, c) * high(k, c) / (sigma_[c] * sigma_[c] * variance_factors[k - first]);
+        chi2 += high(k, c) * high(k, c) / (sigma[c] * sigma[c] * variance_factors[k - first]);
       }
       if (!(chi2 <= limit)) return false;
     }
@@ -386,7 +387,7 @@ class WindowFitter {
       if (!(cholesky.Condition(top) <= kMaxGramCondition)) return true;
       const Eigen::MatrixXd high = cholesky.Solve(top, normal.rhs);
       std::vector<int> degrees(static_cast<size_t>(z.cols()));
-      return ChopDegrees(high, count, &degrees) || TailIsNoise(high, cholesky);
+      return ChopDegrees(high, count, &degrees) || TailIsNoise(high, cholesky, WindowSigma(st, sz, false));
     } catch (const ComputeError&) {
       return true;
     }

@@ -75,14 +75,19 @@ Eigen::VectorXd EstimateNoiseSigma(const Eigen::Ref<const Eigen::MatrixXd>& z, i
   return sigma;
 }
 
-Eigen::VectorXd EstimateNoiseSigma(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
-                                   const std::vector<Eigen::Index>& breaks) {
-  constexpr int kRun = 5;  // 4th divided differences
+namespace {
+
+// A higher order's estimate below this fraction of the lower one's: the lower one holds motion
+// (white noise gives both the same σ, to a few per cent of scatter).
+constexpr double kMotionDrop = 0.8;
+
+// The divided-difference estimate of EstimateNoiseSigma(t, z, breaks) from runs of `run`
+// consecutive samples (order run − 1): per coordinate, 1.4826 · the median of |Σ w_j z_j| / sqrt(Σ w_j²)
+// over the usable runs; zero where there is none.
+template <int kRun>
+Eigen::VectorXd DividedDifferenceSigma(const Eigen::Ref<const Eigen::VectorXd>& t,
+                                       const Eigen::Ref<const Eigen::MatrixXd>& z, const std::vector<char>& cut) {
   const Eigen::Index m = z.rows(), d = z.cols();
-  std::vector<char> cut(static_cast<size_t>(std::max<Eigen::Index>(m, 1)), 0);
-  for (const Eigen::Index b : breaks) {
-    if (b >= 0 && b < m) cut[static_cast<size_t>(b)] = 1;
-  }
   std::vector<std::vector<double>> magnitudes(static_cast<size_t>(d));
   for (auto& values : magnitudes) values.reserve(static_cast<size_t>(std::max<Eigen::Index>(m - kRun + 1, 0)));
   for (Eigen::Index i = 0; i + kRun <= m; ++i) {
@@ -115,6 +120,26 @@ Eigen::VectorXd EstimateNoiseSigma(const Eigen::Ref<const Eigen::VectorXd>& t, c
     auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
     std::nth_element(values.begin(), middle, values.end());
     sigma[c] = 1.4826 * *middle;
+  }
+  return sigma;
+}
+
+}  // namespace
+
+Eigen::VectorXd EstimateNoiseSigma(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
+                                   const std::vector<Eigen::Index>& breaks) {
+  const Eigen::Index m = z.rows();
+  std::vector<char> cut(static_cast<size_t>(std::max<Eigen::Index>(m, 1)), 0);
+  for (const Eigen::Index b : breaks) {
+    if (b >= 0 && b < m) cut[static_cast<size_t>(b)] = 1;
+  }
+  Eigen::VectorXd sigma = DividedDifferenceSigma<5>(t, z, cut);
+  const Eigen::VectorXd sixth = DividedDifferenceSigma<7>(t, z, cut), eighth = DividedDifferenceSigma<9>(t, z, cut);
+  for (Eigen::Index c = 0; c < sigma.size(); ++c) {
+    if (sixth[c] < kMotionDrop * sigma[c]) {
+      sigma[c] = sixth[c];
+      if (eighth[c] < kMotionDrop * sigma[c]) sigma[c] = eighth[c];
+    }
   }
   return sigma;
 }

@@ -130,6 +130,37 @@ TEST(EstimateNoiseSigma, RecoversTheNoiseOfASmoothSignal) {
   }
 }
 
+// Motion up to a tenth of the rate (40 tones at 100 Hz, 0.05 m/s each) reaches the 4th
+// differences by (2 sin(ωh/2))⁴ ≈ 0.15 of its amplitude, ~15 µm against 1 µm of noise; the 6th
+// and 8th take it down by 0.38 per order, and white noise leaves them at σ. Under 1 mm of noise
+// the orders agree and the 4th-order estimate stands.
+TEST(EstimateNoiseSigma, HigherOrdersLookPastMotionInTheUpperBand) {
+  const Eigen::Index m = 4000;
+  Eigen::VectorXd t(m);
+  Eigen::MatrixXd motion = Eigen::MatrixXd::Zero(m, 1);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    t[i] = static_cast<double>(i) * 0.01;
+    for (int k = 1; k <= 40; ++k) {
+      const double w = 2.0 * M_PI * 0.25 * k;  // 0.25..10 Hz
+      motion(i, 0) += 0.05 / w * std::sin(w * t[i] + 0.7 * k * k);
+    }
+  }
+  for (const double sigma : {1e-6, 1e-3}) {
+    std::mt19937_64 rng(13);
+    std::normal_distribution<double> noise(0.0, sigma);
+    Eigen::MatrixXd z = motion;
+    for (Eigen::Index i = 0; i < m; ++i) z(i, 0) += noise(rng);
+    const double fourth = EstimateNoiseSigma(z)[0], estimate = EstimateNoiseSigma(t, z)[0];
+    if (sigma < 1e-5) {
+      EXPECT_GT(fourth, 5.0 * sigma);
+      EXPECT_NEAR(estimate, sigma, 0.15 * sigma);
+    } else {
+      EXPECT_NEAR(estimate, fourth, 1e-9 * fourth);
+      EXPECT_NEAR(estimate, sigma, 0.05 * sigma);
+    }
+  }
+}
+
 // Robust: 1 % of the samples replaced by 1 m outliers (each spoils 5 of the differences, so ~5 %
 // of them) moves the median only slightly, where a standard deviation would be ~1000x too large.
 TEST(EstimateNoiseSigma, OutliersBarelyMoveTheEstimate) {
