@@ -1001,12 +1001,12 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   }
 
   // Where windows clearly missed motion, the samples' own local interpolant (docs/velocity.md).
-  std::vector<Eigen::ArrayXXi> under_resolved;  // per segment, UnderResolvedRates
+  std::vector<internal::LocalRates> local_rates;  // per segment
   bool any_under_resolved = false;
   if (options.lack_of_fit && adaptive) {
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
-      under_resolved.push_back(internal::UnderResolvedRates(t, z, starts[k], starts[k + 1], curve.segments_[k]));
-      any_under_resolved = any_under_resolved || (under_resolved.back() > 0).any();
+      local_rates.push_back(internal::UnderResolvedRates(t, z, starts[k], starts[k + 1], curve.segments_[k]));
+      any_under_resolved = any_under_resolved || local_rates.back().under_resolved.any();
     }
   }
   if (options.lack_of_fit && adaptive && (curve.unresolved_windows() > 0 || any_under_resolved)) {
@@ -1017,7 +1017,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     }
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
       std::vector<LocalRun> runs = internal::LocalRuns(t, z, starts[k], starts[k + 1], curve.segments_[k],
-                                                       under_resolved[k], fit_values, fit_rates, curve.noise_sigma_,
+                                                       local_rates[k], fit_values, fit_rates, curve.noise_sigma_,
                                                        kLackOfFitLimit);
       std::move(runs.begin(), runs.end(), std::back_inserter(curve.local_runs_));
     }

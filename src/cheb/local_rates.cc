@@ -87,7 +87,13 @@ Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> UsableSlopes(const Eigen::Vec
       }
     }
     for (Eigen::Index j = 1; j + 1 < n; ++j) {
-      if (score[j] > kSpikeScales && score[j] >= score[j - 1] && score[j] >= score[j + 1]) usable(j, c) = false;
+      // A step of the values between samples j and j + 1 moves slope j one way and the mean of
+      // each neighbour's two neighbours the other: both neighbours depart the opposite way. Smooth
+      // motion's curvature moves neighbouring departures together, however large it is locally.
+      const bool opposed = departure(j - 1, c) * departure(j, c) < 0.0 && departure(j + 1, c) * departure(j, c) < 0.0;
+      if (score[j] > kSpikeScales && opposed && score[j] >= score[j - 1] && score[j] >= score[j + 1]) {
+        usable(j, c) = false;
+      }
     }
   }
   return usable;
@@ -136,11 +142,12 @@ double QuarticRate(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::In
 
 }  // namespace
 
-Eigen::ArrayXXi UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
-                                   Eigen::Index last, const CurveSegment& segment) {
+LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
+                              Eigen::Index last, const CurveSegment& segment) {
   const Eigen::Index n = last - first, d = z.cols();
   const auto count = static_cast<Eigen::Index>(segment.windows.size());
-  Eigen::ArrayXXi stencil = Eigen::ArrayXXi::Zero(count, d);
+  LocalRates rates{Eigen::ArrayXXi::Constant(count, d, 3),
+                   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(count, d, false)};
   // Per window: the held-out errors' sums of squares of the polynomials through 2, 3 and 4
   // neighbours on either side (degree 3, 5, 7) at the samples where all exist, their noise gains,
   // and Σ 1/h² (the 3-point rate's noise).
@@ -199,14 +206,14 @@ Eigen::ArrayXXi UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::Matrix
       // where both ratios are below 1/2 is the cubic's error motion the samples under-resolve
       // (not noise), and u gives ω.
       const double cubic = squares[0](k, c), quintic = squares[1](k, c), septic = squares[2](k, c);
-      if (!(quintic < kUnderResolved * cubic) || !(septic < kUnderResolved * quintic)) continue;
+      const bool falls = quintic < kUnderResolved * cubic && septic < kUnderResolved * quintic;
       const double u = std::min(4.0, quintic / cubic / 0.09), omega_h = 2.0 * std::asin(0.5 * std::sqrt(u));
       // The degree-7 error less what the motion gives it bounds the noise.
       const double frequency = omega_h / h, noise = std::max(0.0, septic - 0.0816 * u * quintic) / gains(k, 2);
       // What the window missed, at least: its generalised cross-validation error m·RSS/(m − p)²
       // less what the noise gives it, σ²·m/(m − p). Above the 2N/span it resolves, the missed
       // motion's rate errs by that times the frequency.
-      if (!(frequency > 2.0 * (p - 1.0) / span)) continue;
+      const bool above = frequency > 2.0 * (p - 1.0) / span;
       const double missed = m * m * window.residual_rms[c] * window.residual_rms[c] / ((m - p) * (m - p)) -
                             noise * m / (m - p);
       // Each local rate's error: its noise σ²·Σw² and its bias at ω, a fraction of the motion's
@@ -224,16 +231,15 @@ Eigen::ArrayXXi UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::Matrix
       const double error5 = noise * 130.0 / 144.0 * inverse_h2 + motion * bias5 * bias5;
       const double error_spline = noise * 1.392 * inverse_h2 + motion * bias_spline * bias_spline;
       const double best = std::min({error3, error5, error_spline});
-      if (missed > 0.0 && missed * frequency * frequency > best) {
-        stencil(k, c) = best == error_spline ? kSpline : best == error5 ? 5 : 3;
-      }
+      rates.stencil(k, c) = best == error_spline ? kSpline : best == error5 ? 5 : 3;
+      rates.under_resolved(k, c) = falls && above && missed > 0.0 && missed * frequency * frequency > best;
     }
   }
-  return stencil;
+  return rates;
 }
 
 std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
-                                Eigen::Index last, const CurveSegment& segment, const Eigen::ArrayXXi& under_resolved,
+                                Eigen::Index last, const CurveSegment& segment, const LocalRates& rates,
                                 const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
                                 const Eigen::VectorXd& sigma, double lack_of_fit_limit) {
   std::vector<LocalRun> runs;
@@ -259,15 +265,15 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
     if (window.lack_of_fit.size() != d) continue;
     const bool unresolved = window.verdict == WindowVerdict::kUnresolved;
     for (Eigen::Index c = 0; c < d; ++c) {
-      const int under = under_resolved(static_cast<Eigen::Index>(w), c);
+      const auto k = static_cast<Eigen::Index>(w);
       // An unresolved window that interpolates its samples (no freedom left for the residual test)
       // shows nothing better than the samples' own interpolant, whose rate is far better conditioned.
       const bool interpolates = window.samples - window.degrees[static_cast<size_t>(c)] - 1 <= 0;
       local(i, c) = (unresolved && window.lack_of_fit[c] > lack_of_fit_limit &&
                      window.residual_rms[c] >= std::sqrt(2.0) * sigma[c]) ||
-                    (unresolved && interpolates) || under > 0;
-      five(i, c) = under == 5;
-      spline(i, c) = under == kSpline;
+                    (unresolved && interpolates) || rates.under_resolved(k, c);
+      five(i, c) = rates.stencil(k, c) == 5;
+      spline(i, c) = rates.stencil(k, c) == kSpline;
       any = any || local(i, c);
     }
   }
