@@ -996,7 +996,8 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
       return derivative;
     };
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
-      internal::AddEndCaps(t, z, velocity, starts[k], starts[k + 1], &curve.segments_[k]);
+      const bool front_at_jump = k > 0 && curve.segments_[k - 1].continues;
+      internal::AddEndCaps(t, z, velocity, starts[k], starts[k + 1], front_at_jump, &curve.segments_[k]);
     }
   }
 

@@ -12,9 +12,18 @@
 namespace cheval::cheb::internal {
 namespace {
 
-// Candidate caps: samples m from the end, degree p (at most m/4 - 1), and the blending boundary z
-// (in samples from the end: the cap alone up to z/2, blended into the end window up to 1.5 z).
-constexpr std::array<int, 9> kCapSamples{16, 23, 32, 45, 64, 91, 128, 181, 256};
+// Candidate caps: samples m from the end, degree p (at most m/4 - 1 from kLongCap samples on),
+// and the blending boundary z (in samples from the end: the cap alone up to z/2, blended into the
+// end window up to 1.5 z).
+constexpr std::array<int, 11> kCapSamples{8, 11, 16, 23, 32, 45, 64, 91, 128, 181, 256};
+// Caps of fewer samples may spend a coefficient on every 2 samples (m ≥ 2(p + 1) + 1): mid-band
+// motion at 20–50 Hz, whose best Savitzky–Golay window is a cubic over 9 samples. The samples
+// next to a real end can be unlike the artificial ends that choose the cap, and a short cap
+// follows them: at a jump they carry its onset, and short caps are not tried there; at a
+// recording's end (a landing) one is taken only when its pooled gain is kShortCapMargin times the
+// best longer cap's.
+constexpr int kLongCap = 16;
+constexpr double kShortCapMargin = 2.0;
 constexpr std::array<int, 8> kCapDegrees{1, 2, 3, 4, 5, 6, 8, 10};
 constexpr std::array<int, 11> kCapBoundaries{4, 6, 8, 11, 16, 23, 32, 45, 64, 91, 128};
 // Artificial ends per direction (pooled: 2 x 32 one-sided fits per candidate and end; 64 gave the
@@ -146,12 +155,13 @@ struct Choice {
 // Chooses the cap of one end (front: the segment's start) from the artificial ends in [lo, hi).
 Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const VelocityAt& velocity, Eigen::Index lo,
                  Eigen::Index hi, Eigen::Index segment_samples, const CurveWindow& end, Eigen::Index end_samples,
-                 Eigen::Index core_samples) {
+                 Eigen::Index core_samples, int shortest) {
   const Eigen::Index d = z.cols(), room = hi - lo;
   auto boundary_allowed = [&](int m, int boundary) { return 1.5 * boundary <= m - 1 && 2 * boundary <= core_samples; };
   std::vector<Candidate> candidates;
   Eigen::Index block_samples = end_samples, end_offsets = 0;
   for (const int m : kCapSamples) {
+    if (m < shortest) continue;
     if (m > room || 2 * m > segment_samples) break;
     Eigen::Index offsets = 0;
     for (const int boundary : kCapBoundaries) {
@@ -159,7 +169,7 @@ Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloc
     }
     if (offsets == 0) continue;
     for (const int p : kCapDegrees) {
-      if (4 * (p + 1) > m) break;
+      if (m >= kLongCap ? 4 * (p + 1) > m : 2 * (p + 1) + 1 > m) break;
       candidates.push_back({m, p, offsets, Eigen::MatrixXd::Zero(offsets, d), Eigen::MatrixXd::Zero(offsets, d)});
     }
     block_samples = std::max<Eigen::Index>(block_samples, m);
@@ -203,7 +213,7 @@ Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloc
   }
   if (pooled < 8) return {};  // too few artificial ends for pooled errors to be trusted
 
-  Choice best;
+  Choice best, best_short;
   for (size_t i = 0; i < candidates.size();) {
     const int m = candidates[i].samples;
     size_t j = i;
@@ -223,11 +233,12 @@ Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloc
         }
         choice.gain += lowest;
       }
-      if (choice.gain < best.gain) best = std::move(choice);
+      Choice& incumbent = m < kLongCap ? best_short : best;
+      if (choice.gain < incumbent.gain) incumbent = std::move(choice);
     }
     i = j;
   }
-  return best;
+  return best_short.gain < kShortCapMargin * best.gain ? best_short : best;
 }
 
 // The cap window of a choice over samples [begin, begin + m) of the segment.
@@ -280,7 +291,7 @@ CurveWindow BuildCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::
 }  // namespace
 
 void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const VelocityAt& velocity, Eigen::Index first,
-                Eigen::Index last, CurveSegment* segment) {
+                Eigen::Index last, bool front_at_jump, CurveSegment* segment) {
   std::vector<CurveWindow>& windows = segment->windows;
   if (windows.size() < 3) return;
   const double* begin = t.data() + first;
@@ -297,7 +308,9 @@ void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloci
     const CurveWindow& w = front ? windows.front() : windows.back();
     const Eigen::Index end_samples = samples_in(w.fit_begin, w.fit_end);
     const Eigen::Index core_samples = samples_in(w.core_begin, w.core_end);
-    choices[front ? 0 : 1] = ChooseCap(t, z, velocity, lo, hi, last - first, w, end_samples, core_samples);
+    const bool at_jump = front ? front_at_jump : segment->continues;
+    choices[front ? 0 : 1] =
+        ChooseCap(t, z, velocity, lo, hi, last - first, w, end_samples, core_samples, at_jump ? kLongCap : 0);
   }
   // The back first, so that inserting at the front leaves nothing to re-find.
   for (const bool front : {false, true}) {

@@ -8,6 +8,7 @@
 #include <numeric>
 #include <random>
 
+#include <Eigen/QR>
 #include <gtest/gtest.h>
 
 #include "cheval/common/error.h"
@@ -301,6 +302,54 @@ TEST(FitCurve, EndCapsKeepNoiseFreeFitsExactAndSkipShortRecordings) {
   ASSERT_LT(b.segments()[0].windows.size(), 3u);
   EXPECT_EQ(a.segments()[0].windows.size(), b.segments()[0].windows.size());
   EXPECT_EQ(VelocityRmse(a, short_noisy), VelocityRmse(b, short_noisy));
+}
+
+// Mid-band motion at 50 Hz under 0.5 mm of noise: six tones per axis up to a twelfth of the rate
+// (bench/velocity_sweep.py's "mid" motion). The ends' windows are ~20 samples, and a cap of 16
+// samples and more cannot follow 4 Hz motion from one side: the first and last 10 samples erred
+// 2.3x (RMS) as much as the best Savitzky–Golay window there (a cubic over 9 samples, shifted
+// inward at the ends). With caps of 8 and 11 samples, 0.83x.
+TEST(FitCurve, ShortCapsFollowMidBandMotionAtTheEnds) {
+  constexpr int kRate = 50, kZone = 10, kWidth = 9;
+  const Eigen::Index m = 20 * kRate + 1;
+  double cheval = 0.0, savgol = 0.0;
+  for (uint64_t seed = 1; seed <= 6; ++seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    std::normal_distribution<double> noise(0.0, 5e-4);
+    std::vector<int64_t> stamps(static_cast<size_t>(m));
+    Eigen::VectorXd t(m);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      stamps[static_cast<size_t>(i)] = i * (1'000'000'000 / kRate);
+      t[i] = static_cast<double>(i) / kRate;
+    }
+    Eigen::MatrixXd z = Eigen::MatrixXd::Zero(m, 3), truth = Eigen::MatrixXd::Zero(m, 3);
+    for (int k = 0; k < 3; ++k) {
+      for (int tone = 0; tone < 6; ++tone) {
+        const double hz = tone == 0 ? kRate / 12.0 : 0.05 * std::pow(kRate / 12.0 / 0.05, unit(rng));
+        const double w = 2 * M_PI * hz, speed = 0.3 / std::sqrt(6.0) * (0.5 + unit(rng)), phase = 2 * M_PI * unit(rng);
+        z.col(k) += (speed / w * (w * t.array() + phase).sin()).matrix();
+        truth.col(k) += (speed * (w * t.array() + phase).cos()).matrix();
+      }
+    }
+    for (Eigen::Index i = 0; i < m; ++i) z.row(i) += Eigen::RowVector3d(noise(rng), noise(rng), noise(rng));
+    Eigen::MatrixXd p, v;
+    FitCurve(stamps, z).EvaluateMany(stamps, 1, &p, &v);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      if (i >= kZone && i < m - kZone) continue;
+      // The cubic through the 9 samples around i (shifted inward), differentiated at t_i.
+      const Eigen::Index a = std::clamp<Eigen::Index>(i - kWidth / 2, 0, m - kWidth);
+      Eigen::MatrixXd basis(kWidth, 4);
+      for (int r = 0; r < kWidth; ++r) {
+        const double u = t[a + r] - t[i];
+        basis.row(r) << 1.0, u, u * u, u * u * u;
+      }
+      const Eigen::MatrixXd coefficients = basis.colPivHouseholderQr().solve(z.middleRows(a, kWidth));
+      cheval += (v.row(i) - truth.row(i)).squaredNorm();
+      savgol += (coefficients.row(1) - truth.row(i)).squaredNorm();
+    }
+  }
+  EXPECT_LT(cheval, savgol) << "ends: " << std::sqrt(cheval / savgol) << "x the 9-sample cubic's error";
 }
 
 TEST(FitCurve, AbsoluteEpochStampsLoseNothing) {
