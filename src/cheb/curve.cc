@@ -98,7 +98,7 @@ class WindowFitter {
       std::fill(window.degrees.begin(), window.degrees.end(), options_.fixed_degree);
       window.series = FitLeastSquares(tw, zw, options_.fixed_degree, interval);
       window.coefficient_magnitudes = window.series.coefficients.cwiseAbs();
-      LackOfFit(tw, zw, WindowSigma(tw, zw, false), &window);
+      LackOfFit(tw, zw, WindowSigma(zw), &window);
       window.verdict = WindowVerdict::kFixedDegree;
       Finish(&window);
       return window;
@@ -154,7 +154,7 @@ class WindowFitter {
     bool resolved = ChopDegrees(high, m, &window.degrees);
     // The chop looks for a plateau by shape, which a short noisy window can hide: when the top third
     // of the coefficients is statistically pure noise, the window is resolved anyway.
-    const Eigen::VectorXd sigma = WindowSigma(tw, zw, false);
+    const Eigen::VectorXd sigma = WindowSigma(zw);
     if (!resolved) resolved = TailIsNoise(high, *cholesky, sigma);
     if (held_out != nullptr) held_out->resize(0);
     // No plateau and a tail above the noise say that the window *may* miss motion above its top
@@ -230,7 +230,7 @@ class WindowFitter {
       if (!(cholesky.Condition(top) <= kMaxGramCondition)) return false;
       const Eigen::MatrixXd high = cholesky.Solve(top, normal.rhs);
       std::vector<int> degrees(static_cast<size_t>(zw.cols()));
-      const Eigen::VectorXd sigma = WindowSigma(tw, zw, false);
+      const Eigen::VectorXd sigma = WindowSigma(zw);
       if (!ChopDegrees(high, span.count, &degrees) && !TailIsNoise(high, cholesky, sigma)) return false;
       const Centred centred = Centre(normal, zw);
       for (Eigen::Index c = 0; c < zw.cols(); ++c) {
@@ -272,18 +272,14 @@ class WindowFitter {
     return false;
   }
 
-  // The noise σ per coordinate a window's residual is tested against: the data's, floored at a
+  // The noise σ per coordinate a window's samples `z` are tested against: the data's, floored at a
   // rounding level of the values (1e-9 of their magnitude) so that exact data do not ask for an
-  // exact fit. With `local`, the larger of that and the window's own estimate (the same
-  // divided-difference estimate on its samples: noise may be larger in places). The lack-of-fit
-  // test uses the data's alone: a short window's own estimate scatters by tens of per cent, and
+  // exact fit. Not the window's own estimate: a short window's scatters by tens of per cent, and
   // taking the larger would let small unresolved motion pass as noise.
-  Eigen::VectorXd WindowSigma(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
-                              bool local) const {
-    const Eigen::VectorXd own = local ? EstimateNoiseSigma(t, z) : Eigen::VectorXd::Zero(z.cols());
+  Eigen::VectorXd WindowSigma(const Eigen::Ref<const Eigen::MatrixXd>& z) const {
     Eigen::VectorXd sigma(z.cols());
     for (Eigen::Index c = 0; c < z.cols(); ++c) {
-      sigma[c] = std::max({sigma_[c], own[c], 1e-9 * (1.0 + z.col(c).cwiseAbs().maxCoeff())});
+      sigma[c] = std::max(sigma_[c], 1e-9 * (1.0 + z.col(c).cwiseAbs().maxCoeff()));
     }
     return sigma;
   }
@@ -387,7 +383,7 @@ class WindowFitter {
       if (!(cholesky.Condition(top) <= kMaxGramCondition)) return true;
       const Eigen::MatrixXd high = cholesky.Solve(top, normal.rhs);
       std::vector<int> degrees(static_cast<size_t>(z.cols()));
-      return ChopDegrees(high, count, &degrees) || TailIsNoise(high, cholesky, WindowSigma(st, sz, false));
+      return ChopDegrees(high, count, &degrees) || TailIsNoise(high, cholesky, WindowSigma(sz));
     } catch (const ComputeError&) {
       return true;
     }

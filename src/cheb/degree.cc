@@ -90,23 +90,35 @@ Eigen::VectorXd DividedDifferenceSigma(const Eigen::Ref<const Eigen::VectorXd>& 
   const Eigen::Index m = z.rows(), d = z.cols();
   std::vector<std::vector<double>> magnitudes(static_cast<size_t>(d));
   for (auto& values : magnitudes) values.reserve(static_cast<size_t>(std::max<Eigen::Index>(m - kRun + 1, 0)));
+  // Weights in a unit time scale (the run's span): only their ratio to their norm matters. A run
+  // placed like the one before (to 1e-9 of its span: even sampling) keeps its weights.
+  std::array<double, kRun> u{}, placed{}, w{};
+  double norm = 0.0;
+  bool known = false;
   for (Eigen::Index i = 0; i + kRun <= m; ++i) {
     bool usable = true;
     for (Eigen::Index j = i; j + 1 < i + kRun && usable; ++j) usable = !cut[static_cast<size_t>(j)] && t[j + 1] > t[j];
     if (!usable) continue;
-    // Weights in a unit time scale (the run's span): only their ratio to their norm matters.
     const double span = t[i + kRun - 1] - t[i];
-    std::array<double, kRun> w{};
-    double norm = 0.0;
+    bool same = known;
     for (int j = 0; j < kRun; ++j) {
-      double product = 1.0;
-      for (int k = 0; k < kRun; ++k) {
-        if (k != j) product *= (t[i + j] - t[i + k]) / span;
-      }
-      w[j] = 1.0 / product;
-      norm += w[j] * w[j];
+      u[j] = (t[i + j] - t[i]) / span;
+      same = same && std::abs(u[j] - placed[j]) <= 1e-9;
     }
-    norm = std::sqrt(norm);
+    if (!same) {
+      norm = 0.0;
+      for (int j = 0; j < kRun; ++j) {
+        double product = 1.0;
+        for (int k = 0; k < kRun; ++k) {
+          if (k != j) product *= u[j] - u[k];
+        }
+        w[j] = 1.0 / product;
+        norm += w[j] * w[j];
+      }
+      norm = std::sqrt(norm);
+      placed = u;
+      known = true;
+    }
     for (Eigen::Index c = 0; c < d; ++c) {
       double sum = 0.0;
       for (int j = 1; j < kRun; ++j) sum += w[j] * (z(i + j, c) - z(i, c));  // Σ w_j = 0
