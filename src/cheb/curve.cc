@@ -1002,7 +1002,8 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   bool any_under_resolved = false;
   if (options.lack_of_fit && adaptive) {
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
-      local_rates.push_back(internal::UnderResolvedRates(t, z, starts[k], starts[k + 1], curve.segments_[k]));
+      local_rates.push_back(
+          internal::UnderResolvedRates(t, z, starts[k], starts[k + 1], curve.segments_[k], curve.noise_sigma_));
       any_under_resolved = any_under_resolved || local_rates.back().under_resolved.any();
     }
   }

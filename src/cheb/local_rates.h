@@ -21,17 +21,20 @@ struct LocalRates {
   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> under_resolved;
 };
 
-/// The LocalRates of the windows of `segment`; needs no σ (the noise estimate can read such motion
-/// as noise). Over the window's core, the held-out errors of the polynomials of degree 3, 5 and 7
-/// through 2, 3 and 4 neighbours on either side fall by u·(6/20)² and u·(20/70)² from each order to
-/// the next for motion of frequency ω, u = (2 sin(ωh/2))², which gives ω (white noise keeps them
-/// level; the degree-7 error bounds the noise). The stencil is the rate whose error, its noise plus
-/// its bias at ω, is least. The samples under-resolve the motion when both falls are by more than
-/// half, ω lies above the 2N/span the window resolves, and the rate error of the missed motion,
-/// ω² times the window's generalised cross-validation error less its noise, exceeds the stencil's.
-/// docs/velocity.md, "Local interpolant".
+/// The LocalRates of the windows of `segment`. Over the window's core, the held-out errors of the
+/// polynomials of degree 3, 5 and 7 through 2, 3 and 4 neighbours on either side fall by
+/// u·(6/20)² and u·(20/70)² from each order to the next for motion of frequency ω,
+/// u = (2 sin(ωh/2))², which gives ω (white noise keeps them level; the degree-7 error bounds the
+/// noise). The stencil is the rate whose error by that model, its noise plus its bias at ω, is
+/// least; where that is the 3-point rate, the spline's slopes replace it when the mean squared
+/// difference between the two exceeds 1.177·σ²/h² (`sigma` the noise per coordinate): the model
+/// reads a spread spectrum near a quarter of the rate as noise, and σ too can only make this test
+/// stricter. The samples under-resolve the motion (this needs no σ) when both falls are by more
+/// than half, ω lies above the 2N/span the window resolves, and the rate error of the missed
+/// motion, ω² times the window's generalised cross-validation error less its noise, exceeds the
+/// model's least. docs/velocity.md, "Local interpolant".
 LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
-                              Eigen::Index last, const CurveSegment& segment);
+                              Eigen::Index last, const CurveSegment& segment, const Eigen::VectorXd& sigma);
 
 /// The local runs of one segment. A sample is local in coordinate c when it lies in the core of
 /// a window accepted unresolved whose residual in c is clearly above the noise (the lack-of-fit
