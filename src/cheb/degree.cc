@@ -81,9 +81,10 @@ namespace {
 // (white noise gives both the same σ, to a few per cent of scatter).
 constexpr double kMotionDrop = 0.8;
 
-// The divided-difference estimate of EstimateNoiseSigma(t, z, breaks) from runs of `run`
-// consecutive samples (order run − 1): per coordinate, 1.4826 · the median of |Σ w_j z_j| / sqrt(Σ w_j²)
-// over the usable runs; zero where there is none.
+// The divided-difference estimate of EstimateNoiseSigma(t, z, breaks) from runs of kRun
+// consecutive samples (order kRun − 1; `cut` marks the boundaries a run may not cross): per
+// coordinate, 1.4826 · the median of |Σ w_j z_j| / sqrt(Σ w_j²) over the usable runs; zero where
+// there is none.
 template <int kRun>
 Eigen::VectorXd DividedDifferenceSigma(const Eigen::Ref<const Eigen::VectorXd>& t,
                                        const Eigen::Ref<const Eigen::MatrixXd>& z, const std::vector<char>& cut) {

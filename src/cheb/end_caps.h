@@ -29,8 +29,8 @@ using VelocityAt = std::function<Eigen::MatrixXd(Eigen::Index first, Eigen::Inde
 /// `t` (sorted, s) and `z` (m x d) are the curve's samples, `velocity` gives the fitted curve's
 /// velocity at them (asked only where the artificial ends need it), [first, last) the segment's
 /// samples; `front_at_jump` says the segment starts at a jump (its end at one: `continues`), where
-/// no cap shorter than 16 samples is tried. The cap becomes the segment's first (or last) window; the neighbouring end window's
-/// core is shortened to make room. Segments too short for artificial ends (fewer than three
+/// no cap shorter than 16 samples is tried. The cap becomes the segment's first (or last) window;
+/// the neighbouring end window's core is shortened to make room. Segments too short for artificial ends (fewer than three
 /// windows, or an interior shorter than the windows) are left as they are.
 void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const VelocityAt& velocity, Eigen::Index first,
                 Eigen::Index last, bool front_at_jump, CurveSegment* segment);
