@@ -24,6 +24,9 @@ constexpr int kPilotHalf = 7, kBiasHalf = 5;
 constexpr int kSpareSamples = 3;
 // A candidate replaces the windows only when its estimated gain is this many standard errors.
 constexpr double kSignificance = 2.0;
+// The pilot's bias estimate is discounted by its standard errors only where the noise share it
+// subtracts is at least this fraction of the differences it is subtracted from.
+constexpr double kBiasNoiseShare = 0.5;
 // Samples per block of the gains' standard error: the widest candidate's.
 constexpr Eigen::Index kBlock = 53;
 // Shorter stretches are left to the windows: fewer than 4 blocks say little about the scatter.
@@ -290,12 +293,21 @@ struct StretchScores {
       }
     }
     // The pilot's squared bias (its rate's mean squared difference from the reference's less
-    // the noise's share) counts as far as it stands out of its own scatter: that estimate
-    // subtracts a noise term some 10x the bias it leaves, and a per-cent error of σ² or the
-    // scatter of the differences would otherwise veto every candidate at random.
+    // the noise's share) counts as far as it stands out of its own scatter where that noise share
+    // dominates: the estimate then subtracts a noise term some 10x the bias it leaves, and a
+    // per-cent error of σ² or the scatter of the differences would otherwise veto every
+    // candidate at random. Where the noise share is under half the differences (nearly
+    // noise-free motion), their scatter is the bias's own variation along the stretch, and
+    // discounting it let the pilot replace windows ten times better (docs/velocity.md).
     const auto [bias_mean, bias_error] = MeanAndError(
         [&](size_t b) { return block_bias_differences[b][c] - variance * block_bias_variance[b]; });
-    const double bias = static_cast<double>(length) * std::max(0.0, bias_mean - kSignificance * bias_error);
+    double differences_total = 0.0, noise_total = 0.0;
+    for (size_t b = 0; b < block_bias_variance.size(); ++b) {
+      differences_total += block_bias_differences[b][c];
+      noise_total += variance * block_bias_variance[b];
+    }
+    const double discount = noise_total < kBiasNoiseShare * differences_total ? 0.0 : kSignificance * bias_error;
+    const double bias = static_cast<double>(length) * std::max(0.0, bias_mean - discount);
     const double windows_score = window_differences[c] + 2.0 * variance * window_products[c];
     if (chosen < 0 || !(best + 2.0 * bias < windows_score)) return -1;
     // The gain must stand out of its own scatter: 2 standard errors of the mean of the blocks'.

@@ -10,41 +10,15 @@
 #include <gtest/gtest.h>
 
 #include "cheval/cheb/curve.h"
+#include "synthetic_motion.h"
 
 namespace cheval::cheb {
 namespace {
 
-struct Tones {
-  std::vector<int64_t> stamps;
-  Eigen::MatrixXd positions, velocities;  // m x 3
-};
-
-struct Tone {
-  int axis;
-  double hz, amplitude, phase;  // position amplitude (m)
-};
-
-// The tones sampled at `rate_hz` for 20 s, each sample's coordinates then drawn with noise σ.
-Tones Synthesize(double rate_hz, const std::vector<Tone>& tones, double noise, std::mt19937_64* rng) {
-  std::normal_distribution<double> gauss(0.0, 1.0);
-  const auto m = static_cast<Eigen::Index>(20.0 * rate_hz) + 1;
-  Tones s;
-  s.positions = Eigen::MatrixXd::Zero(m, 3);
-  s.velocities = Eigen::MatrixXd::Zero(m, 3);
-  for (Eigen::Index i = 0; i < m; ++i) {
-    s.stamps.push_back(std::llround(static_cast<double>(i) / rate_hz * 1e9));
-    const double t = static_cast<double>(i) / rate_hz;
-    for (const Tone& tone : tones) {
-      const double w = 2.0 * M_PI * tone.hz;
-      s.positions(i, tone.axis) += tone.amplitude * std::sin(w * t + tone.phase);
-      s.velocities(i, tone.axis) += tone.amplitude * w * std::cos(w * t + tone.phase);
-    }
-    if (noise > 0.0) {
-      for (int c = 0; c < 3; ++c) s.positions(i, c) += noise * gauss(*rng);
-    }
-  }
-  return s;
-}
+using testing_motion::Broad;
+using testing_motion::Synthesize;
+using testing_motion::Tone;
+using testing_motion::Tones;
 
 // Per axis, a slow sinusoid plus three of 5 mm/s..0.1 m/s rate at up to `fastest` of the rate,
 // sampled at `rate_hz` for 20 s, with noise σ.
@@ -114,25 +88,6 @@ TEST(UnderResolved, AVibrationNearAQuarterOfTheRateTakesTheSplinesSlopes) {
   const auto [rmse, central] = Errors(s, &local);
   // Before the local rate: 2.1x central differences; with the 5-point rate only: 0.41x.
   EXPECT_LT(rmse, 0.3 * central) << rmse << " m/s against central differences' " << central;
-}
-
-// Per axis, 160 tones spread up to 1.5 f_max whose velocity spectrum is flat to f_max and then
-// falls as f⁻⁴ (bench/velocity_sweep.py's "broad" motion), 0.3 m/s in all, sampled at `rate_hz`
-// for 20 s without noise.
-Tones Broad(double rate_hz, double f_max, uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::normal_distribution<double> gauss(1.0, 0.3);
-  constexpr int kTones = 160;
-  std::vector<Tone> tones;
-  for (int j = 0; j < 3 * kTones; ++j) {
-    const int k = j % kTones;
-    const double hz = (0.02 + (1.5 * f_max - 0.02) * k / (kTones - 1)) * (0.97 + 0.06 * unit(rng));
-    const double shape = 1.0 / std::sqrt(1.0 + std::pow(hz / f_max, 8));
-    const double amplitude = 0.3 * std::sqrt(2.0 / kTones) * shape * std::abs(gauss(rng)) / (2.0 * M_PI * hz);
-    tones.push_back({j / kTones, hz, amplitude, 2.0 * M_PI * unit(rng)});
-  }
-  return Synthesize(rate_hz, tones, 0.0, &rng);
 }
 
 // Velocity RMSE of the fit and of the 5-point rate (the quartic's derivative, the best
