@@ -711,16 +711,12 @@ std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::Ve
 void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegment& segment,
                 const CurveOptions& options) {
   if (options.end_degree <= 0) return;
-  auto samples_in = [&t](double a, double b) { return SamplesIn(t, a, b); };
   const Eigen::Index minimum = EndWindowMinimum(options);
   for (const bool front : {true, false}) {
     while (true) {
       auto& windows = segment.windows;
       const CurveWindow& end = front ? windows.front() : windows.back();
-      if (MaxDegree(end) <= options.end_degree ||
-          samples_in(end.core_begin, end.core_end) < minimum) {
-        break;
-      }
+      if (MaxDegree(end) <= options.end_degree || SamplesIn(t, end.core_begin, end.core_end) < minimum) break;
       // Halving one step at a time fits every outer half on the way and drops all but the last.
       // A resolved motion needs a degree about proportional to the window's length, so the cuts
       // the halvings are expected to make are taken at once (each halved piece holding enough
@@ -734,7 +730,7 @@ void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegme
       const bool predict = options.degree_method == DegreeMethod::kCrossValidation;
       std::vector<double> cuts{front ? b : a};  // from the inside out
       for (double degree = MaxDegree(end); degree > options.end_degree && (predict || cuts.size() < 2); degree *= 0.5) {
-        if (cuts.size() > 1 && (front ? samples_in(a, cuts.back()) : samples_in(cuts.back(), b)) < minimum) break;
+        if (cuts.size() > 1 && (front ? SamplesIn(t, a, cuts.back()) : SamplesIn(t, cuts.back(), b)) < minimum) break;
         cuts.push_back(front ? 0.5 * (a + cuts.back()) : 0.5 * (cuts.back() + b));
       }
       auto fit_end = [&](double cut) {

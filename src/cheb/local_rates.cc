@@ -125,12 +125,12 @@ bool HeldOut(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index fi
   return true;
 }
 
-// The derivative at times[i] of the quadratic through rows a, a + 1, a + 2 (distinct stamps).
-double QuadraticRate(const std::vector<double>& times, const Eigen::VectorXd& values, Eigen::Index a, Eigen::Index i) {
-  const double t0 = times[a], t1 = times[a + 1], t2 = times[a + 2], x = times[i];
-  const double d01 = (values[a + 1] - values[a]) / (t1 - t0), d12 = (values[a + 2] - values[a + 1]) / (t2 - t1);
-  const double curvature = (d12 - d01) / (t2 - t0);  // half the second derivative
-  return d01 + curvature * (2.0 * x - t0 - t1);
+// The derivative of the quadratic through three consecutive samples, from the slopes d0 and d1
+// over the steps h0 and h1 between them: at the middle sample, and at an end sample (the near
+// step's and the far step's).
+double CentredRate(double h0, double d0, double h1, double d1) { return (h1 * d0 + h0 * d1) / (h0 + h1); }
+double EndRate(double h_near, double d_near, double h_far, double d_far) {
+  return d_near - h_near * (d_far - d_near) / (h_near + h_far);
 }
 
 // The derivative at sample i of the quartic through samples i − 2 .. i + 2 (distinct stamps).
@@ -172,9 +172,10 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
   }
   // The slopes of the cubic spline through the segment's samples (clamped at the 3-point rates at
   // its ends), and per window Σ (r₃ − r_s)², the 3-point rate's squared departure from them.
-  std::vector<double> times(t.data() + first, t.data() + last);
-  bool distinct = n >= 3;
-  for (Eigen::Index i = 1; i < n && distinct; ++i) distinct = times[static_cast<size_t>(i)] > times[static_cast<size_t>(i - 1)];
+  const std::vector<double> times(t.data() + first, t.data() + last);
+  const Eigen::VectorXd steps = n >= 3 ? Eigen::VectorXd(t.segment(first + 1, n - 1) - t.segment(first, n - 1))
+                                       : Eigen::VectorXd();
+  const bool distinct = n >= 3 && (steps.array() > 0.0).all();
   Eigen::MatrixXd spline_rates, three_rates;
   Eigen::MatrixXd departures = Eigen::MatrixXd::Zero(count, d);
   Eigen::VectorXd counted = Eigen::VectorXd::Zero(count);
@@ -183,10 +184,12 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
     three_rates.resize(n, d);
     for (Eigen::Index c = 0; c < d; ++c) {
       const Eigen::VectorXd values = z.col(c).segment(first, n);
-      for (Eigen::Index i = 0; i < n; ++i) {
-        const Eigen::Index a = std::clamp<Eigen::Index>(i - 1, 0, n - 3);
-        three_rates(i, c) = QuadraticRate(times, values, a, i);
+      const Eigen::VectorXd slopes = (values.tail(n - 1) - values.head(n - 1)).cwiseQuotient(steps);
+      three_rates(0, c) = EndRate(steps[0], slopes[0], steps[1], slopes[1]);
+      for (Eigen::Index i = 1; i + 1 < n; ++i) {
+        three_rates(i, c) = CentredRate(steps[i - 1], slopes[i - 1], steps[i], slopes[i]);
       }
+      three_rates(n - 1, c) = EndRate(steps[n - 2], slopes[n - 2], steps[n - 3], slopes[n - 3]);
       spline_rates(0, c) = three_rates(0, c);
       spline_rates(n - 1, c) = three_rates(n - 1, c);
       SplineSlopes(times, values, 1, n - 2, spline_rates.col(c));
@@ -335,17 +338,13 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
       return QuarticRate(t, z, first + i, c);
     }
     const bool left = i >= 1 && usable(i - 1, c), right = i + 1 < n && usable(i, c);
-    if (left && right) return (h[i] * slopes(i - 1, c) + h[i - 1] * slopes(i, c)) / (h[i - 1] + h[i]);
+    if (left && right) return CentredRate(h[i - 1], slopes(i - 1, c), h[i], slopes(i, c));
     if (right) {
-      if (i + 2 < n && usable(i + 1, c)) {
-        return slopes(i, c) - h[i] * (slopes(i + 1, c) - slopes(i, c)) / (h[i] + h[i + 1]);
-      }
+      if (i + 2 < n && usable(i + 1, c)) return EndRate(h[i], slopes(i, c), h[i + 1], slopes(i + 1, c));
       return slopes(i, c);
     }
     if (left) {
-      if (i >= 2 && usable(i - 2, c)) {
-        return slopes(i - 1, c) + h[i - 1] * (slopes(i - 1, c) - slopes(i - 2, c)) / (h[i - 2] + h[i - 1]);
-      }
+      if (i >= 2 && usable(i - 2, c)) return EndRate(h[i - 1], slopes(i - 1, c), h[i - 2], slopes(i - 2, c));
       return slopes(i - 1, c);
     }
     return fit_rates(first + i, c);
