@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <vector>
 
 namespace cheval::cheb::internal {
@@ -17,6 +18,17 @@ constexpr Eigen::Index kBlock = 64;
 constexpr double kMinHeldOut = 8;
 // UnderResolvedRates' code for the interpolating spline's slopes.
 constexpr int kSpline = 9;
+// The variance of the interpolating cubic spline's slopes over σ²/h² for white noise at even spacing.
+constexpr double kSplineNoiseGain = 1.392;
+// Windows on either side of a window pooled into its departure from the spline's slopes: the
+// smallest windows' cores hold 15–25 samples, too few for a mean square to decide by.
+constexpr Eigen::Index kPooledWindows = 2;
+// Standard errors of its pooled mean by which a window's departure from the spline's slopes must
+// pass the break-even: at the break-even the expected gain is nil, and of the hundreds of windows
+// tested, those that pass only by their mean's scatter lose (tests/cheb/under_resolved_test.cc).
+constexpr double kDepartureMargin = 1.0;
+// Samples beyond the end sample in the one-sided stencil of higher order (LocalRuns).
+constexpr Eigen::Index kOneSided = 5;
 
 // The slopes of the cubic spline through (times, values) that are C² at rows a..b, given the
 // slopes at rows a − 1 and b + 1 (clamped): the tridiagonal system
@@ -133,14 +145,16 @@ double EndRate(double h_near, double d_near, double h_far, double d_far) {
   return d_near - h_near * (d_far - d_near) / (h_near + h_far);
 }
 
-// The derivative at sample i of the quartic through samples i − 2 .. i + 2 (distinct stamps).
-double QuarticRate(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index i, Eigen::Index c) {
+// The derivative at sample i of the polynomial through samples lo .. hi (distinct stamps; i among
+// them): the quartic through i − 2 .. i + 2 in the interior, one-sided at a segment's end.
+double LagrangeRate(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index i, Eigen::Index c, Eigen::Index lo,
+                    Eigen::Index hi) {
   double rate = 0.0, own = 0.0;
-  for (Eigen::Index j = i - 2; j <= i + 2; ++j) {
+  for (Eigen::Index j = lo; j <= hi; ++j) {
     if (j == i) continue;
     own += 1.0 / (t[i] - t[j]);
     double weight = 1.0 / (t[j] - t[i]);
-    for (Eigen::Index l = i - 2; l <= i + 2; ++l) {
+    for (Eigen::Index l = lo; l <= hi; ++l) {
       if (l != j && l != i) weight *= (t[i] - t[l]) / (t[j] - t[l]);
     }
     rate += weight * z(j, c);
@@ -155,7 +169,7 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
   const Eigen::Index n = last - first, d = z.cols();
   const auto count = static_cast<Eigen::Index>(segment.windows.size());
   LocalRates rates{Eigen::ArrayXXi::Constant(count, d, 3),
-                   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(count, d, false)};
+                   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(count, d, false), Eigen::MatrixXd()};
   // Per window: the held-out errors' sums of squares of the polynomials through 2, 3 and 4
   // neighbours on either side (degree 3, 5, 7) at the samples where all exist, their noise gains,
   // and Σ 1/h² (the 3-point rate's noise).
@@ -282,8 +296,64 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
       rates.under_resolved(k, c) = falls && above && missed > 0.0 && missed * frequency * frequency > best;
     }
   }
+  rates.spline_slopes = std::move(spline_rates);
   return rates;
 }
+
+namespace {
+
+// Per window of the segment and coordinate (row-major, window · d + c): whether the window's rate
+// departs from the spline's slopes by more than the spline's noise allows, where the window's missed
+// motion could hold that departure (LocalRuns).
+std::vector<bool> DepartsFromSpline(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
+                                    const CurveSegment& segment, const LocalRates& rates,
+                                    const Eigen::MatrixXd& fit_rates, const Eigen::VectorXd& sigma) {
+  const std::vector<CurveWindow>& windows = segment.windows;
+  const auto count = static_cast<Eigen::Index>(windows.size());
+  const Eigen::Index d = fit_rates.cols();
+  std::vector<bool> departs(static_cast<size_t>(count * d), false);
+  if (rates.spline_slopes.rows() != n) return departs;
+  // Per window: Σ (r_s − r_fit)² over its core's interior samples, their count and Σ 1/h² (h half
+  // the span of a sample's neighbours).
+  Eigen::MatrixXd squares = Eigen::MatrixXd::Zero(count, d), fourth = squares;
+  Eigen::VectorXd samples = Eigen::VectorXd::Zero(count), inverse_h2 = Eigen::VectorXd::Zero(count);
+  Eigen::Index w = 0;
+  for (Eigen::Index i = 1; i + 1 < n; ++i) {
+    while (w + 1 < count && t[first + i] >= windows[static_cast<size_t>(w + 1)].core_begin) ++w;
+    const double h = 0.5 * (t[first + i + 1] - t[first + i - 1]);
+    const Eigen::RowVectorXd sq = (rates.spline_slopes.row(i) - fit_rates.row(first + i)).cwiseAbs2();
+    squares.row(w) += sq;
+    fourth.row(w) += sq.cwiseAbs2();
+    samples[w] += 1.0;
+    inverse_h2[w] += 1.0 / (h * h);
+  }
+  for (Eigen::Index k = 0; k < count; ++k) {
+    // An end cap is judged by the end window it was cut from (as in LocalRuns).
+    const bool cap = windows[static_cast<size_t>(k)].lack_of_fit.size() != d && count > 1 && (k == 0 || k + 1 == count);
+    const CurveWindow& window = windows[static_cast<size_t>(cap ? (k == 0 ? 1 : k - 1) : k)];
+    if (window.residual_rms.size() != d) continue;
+    const Eigen::Index a = std::max<Eigen::Index>(0, k - kPooledWindows), b = std::min(count - 1, k + kPooledWindows);
+    const double pooled = samples.segment(a, b - a + 1).sum();
+    if (pooled < kMinHeldOut) continue;
+    const double mean_inverse_h2 = inverse_h2.segment(a, b - a + 1).sum() / pooled;
+    const double m = window.samples;
+    for (Eigen::Index c = 0; c < d; ++c) {
+      const double departure = squares.col(c).segment(a, b - a + 1).sum() / pooled;
+      const double noise = kSplineNoiseGain * sigma[c] * sigma[c] * mean_inverse_h2;
+      const double spread = fourth.col(c).segment(a, b - a + 1).sum() / pooled - departure * departure;
+      const double se = std::sqrt(std::max(0.0, spread) / pooled);
+      if (!(departure - kDepartureMargin * se > 2.0 * noise)) continue;
+      const double p = window.degrees[static_cast<size_t>(c)] + 1.0;
+      if (!(m > p)) continue;
+      const double rr = window.residual_rms[c];
+      const double missed = m * m * rr * rr / ((m - p) * (m - p)) - sigma[c] * sigma[c] * m / (m - p);
+      departs[static_cast<size_t>(k * d + c)] = missed * std::numbers::pi * std::numbers::pi * mean_inverse_h2 >= departure - noise;
+    }
+  }
+  return departs;
+}
+
+}  // namespace
 
 std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                 Eigen::Index last, const CurveSegment& segment, const LocalRates& rates,
@@ -300,6 +370,7 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> five =
       Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, false);
   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> spline = five;
+  const std::vector<bool> departs = DepartsFromSpline(t, first, n, segment, rates, fit_rates, sigma);
   size_t w = 0;
   bool any = false;
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -316,9 +387,11 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
       // An unresolved window that interpolates its samples (no freedom left for the residual test)
       // shows nothing better than the samples' own interpolant, whose rate is far better conditioned.
       const bool interpolates = window.samples - window.degrees[static_cast<size_t>(c)] - 1 <= 0;
-      local(i, c) = (unresolved && window.lack_of_fit[c] > lack_of_fit_limit &&
-                     window.residual_rms[c] >= std::sqrt(2.0) * sigma[c]) ||
-                    (unresolved && interpolates) || rates.under_resolved(k, c);
+      const double dof = window.samples - window.degrees[static_cast<size_t>(c)] - 1.0;
+      const double variance = window.residual_rms[c] * window.residual_rms[c] * window.samples / std::max(dof, 1.0);
+      const bool missed = window.lack_of_fit[c] > lack_of_fit_limit && variance >= 2.0 * sigma[c] * sigma[c];
+      local(i, c) = (unresolved && (interpolates || missed || departs[static_cast<size_t>(k * d + c)])) ||
+                    rates.under_resolved(k, c);
       five(i, c) = rates.stencil(k, c) == 5;
       spline(i, c) = rates.stencil(k, c) == kSpline;
       any = any || local(i, c);
@@ -335,10 +408,20 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
   // The derivative at sample i of the quadratic through it and its neighbours, from usable slopes.
   auto rate = [&](Eigen::Index i, Eigen::Index c) {
     if (five(i, c) && i >= 2 && i + 2 < n && usable(i - 2, c) && usable(i - 1, c) && usable(i, c) && usable(i + 1, c)) {
-      return QuarticRate(t, z, first + i, c);
+      return LagrangeRate(t, z, first + i, c, first + i - 2, first + i + 2);
     }
     const bool left = i >= 1 && usable(i - 1, c), right = i + 1 < n && usable(i, c);
     if (left && right) return CentredRate(h[i - 1], slopes(i - 1, c), h[i], slopes(i, c));
+    // At a segment's end, where the window's stencil is of higher order than the quadratic's, the
+    // quintic's through the end sample and the next five: a one-sided stencil's error constant is
+    // several times the centred one's of the same order, and one order more makes up for it.
+    const bool higher = five(i, c) || spline(i, c);
+    if (higher && i == 0 && n > kOneSided && usable.col(c).head(kOneSided).all()) {
+      return LagrangeRate(t, z, first, c, first, first + kOneSided);
+    }
+    if (higher && i == n - 1 && n > kOneSided && usable.col(c).segment(n - 1 - kOneSided, kOneSided).all()) {
+      return LagrangeRate(t, z, first + i, c, first + n - 1 - kOneSided, first + n - 1);
+    }
     if (right) {
       if (i + 2 < n && usable(i + 1, c)) return EndRate(h[i], slopes(i, c), h[i + 1], slopes(i + 1, c));
       return slopes(i, c);

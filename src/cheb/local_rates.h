@@ -19,6 +19,9 @@ namespace cheval::cheb::internal {
 struct LocalRates {
   Eigen::ArrayXXi stencil;
   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> under_resolved;
+  /// The slopes of the cubic spline through the segment's samples, clamped at the 3-point rates at
+  /// its ends (n x d; empty where two stamps coincide).
+  Eigen::MatrixXd spline_slopes;
 };
 
 /// The LocalRates of the windows of `segment`. Over the window's core, the held-out errors of the
@@ -37,11 +40,23 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
                               Eigen::Index last, const CurveSegment& segment, const Eigen::VectorXd& sigma);
 
 /// The local runs of one segment. A sample is local in coordinate c when it lies in the core of
-/// a window accepted unresolved whose residual in c is clearly above the noise (the lack-of-fit
-/// score above its limit and the residual RMS at least sqrt(2)·σ: the missed motion is at least as
-/// large as the noise, so the samples' own local derivative, whose noise is σ/(sqrt(2)·h), is the
-/// better estimate), or of a window whose samples under-resolve the motion (`rates`). A run is a
-/// maximal stretch of consecutive samples local in some coordinate,
+/// a window accepted unresolved
+/// - whose residual in c is clearly above the noise: the lack-of-fit score above its limit and the
+///   residual's variance on its degrees of freedom, RSS/(m − N − 1), at least 2σ² (the missed
+///   motion is at least as large as the noise, so the samples' own local derivative, whose noise
+///   is σ/(sqrt(2)·h), is the better estimate);
+/// - or whose rate departs from the spline's slopes (`rates.spline_slopes`) by more than the
+///   spline's noise allows: over the window and two on either side, the mean (r_s − r_fit)² above
+///   twice the spline's noise, 1.392·σ²/h² (the break-even: r_s − r_fit holds the spline's noise
+///   and the window's bias, and the spline's bias is small, so the window's bias exceeds the
+///   spline's noise), where the window's missed motion could hold that bias: its generalised
+///   cross-validation error less the noise's share, times (π/h)² (a component of the positions
+///   below the sampling rate's Nyquist frequency errs in rate by at most that), reaches the mean
+///   departure less the spline's noise. Motion near a quarter of the rate that no window resolves
+///   lies mostly below the noise in each window's residual; in its rate it is clear;
+/// - or of a window whose samples under-resolve the motion (`rates`).
+///
+/// A run is a maximal stretch of consecutive samples local in some coordinate,
 /// with one sample of the fit on either side inside the segment (its value and derivative are the
 /// fit's: the curve stays C¹ where it passes from the fit to the samples).
 ///
