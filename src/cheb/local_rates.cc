@@ -145,6 +145,22 @@ double EndRate(double h_near, double d_near, double h_far, double d_far) {
   return d_near - h_near * (d_far - d_near) / (h_near + h_far);
 }
 
+// What window missed in coordinate c, at least: its generalised cross-validation error
+// m·RSS/(m − p)² (p = N + 1 coefficients) less what noise of variance `noise` gives it, σ²·m/(m − p).
+double MissedMotion(const CurveWindow& window, Eigen::Index c, double noise) {
+  const double m = window.samples, p = window.degrees[static_cast<size_t>(c)] + 1.0;
+  const double rms = window.residual_rms[c];
+  return m * m * rms * rms / ((m - p) * (m - p)) - noise * m / (m - p);
+}
+
+// The window whose residual test judges the samples of window w: an end cap (no residual test of
+// its own) takes the verdict of the end window it was cut from, whose samples it covers and whose
+// polynomial it keeps where no cap fit helps.
+const CurveWindow& JudgingWindow(const std::vector<CurveWindow>& windows, size_t w, Eigen::Index d) {
+  const bool cap = windows[w].lack_of_fit.size() != d && windows.size() > 1 && (w == 0 || w + 1 == windows.size());
+  return cap ? windows[w == 0 ? 1 : w - 1] : windows[w];
+}
+
 // The derivative at sample i of the polynomial through samples lo .. hi (distinct stamps; i among
 // them): the quartic through i − 2 .. i + 2 in the interior, one-sided at a segment's end.
 double LagrangeRate(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index i, Eigen::Index c, Eigen::Index lo,
@@ -261,12 +277,10 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
       const double u = std::min(4.0, quintic / cubic / 0.09), omega_h = 2.0 * std::asin(0.5 * std::sqrt(u));
       // The degree-7 error less what the motion gives it bounds the noise.
       const double frequency = omega_h / h, noise = std::max(0.0, septic - 0.0816 * u * quintic) / gains(k, 2);
-      // What the window missed, at least: its generalised cross-validation error m·RSS/(m − p)²
-      // less what the noise gives it, σ²·m/(m − p). Above the 2N/span it resolves, the missed
-      // motion's rate errs by that times the frequency.
+      // What the window missed (MissedMotion, with that noise): above the 2N/span it resolves, the
+      // missed motion's rate errs by that times the frequency.
       const bool above = frequency > 2.0 * (p - 1.0) / span;
-      const double missed = m * m * window.residual_rms[c] * window.residual_rms[c] / ((m - p) * (m - p)) -
-                            noise * m / (m - p);
+      const double missed = MissedMotion(window, c, noise);
       // Each local rate's error: its noise σ²·Σw² and its bias at ω, a fraction of the motion's
       // rate, the motion being 6/u² of the cubic's error. The 3-point rate (central difference):
       // Σw² = 1/(2h²), fraction 1 − sin(ωh)/ωh; the 5-point one (the quartic's derivative):
@@ -328,26 +342,22 @@ std::vector<bool> DepartsFromSpline(const Eigen::VectorXd& t, Eigen::Index first
     inverse_h2[w] += 1.0 / (h * h);
   }
   for (Eigen::Index k = 0; k < count; ++k) {
-    // An end cap is judged by the end window it was cut from (as in LocalRuns).
-    const bool cap = windows[static_cast<size_t>(k)].lack_of_fit.size() != d && count > 1 && (k == 0 || k + 1 == count);
-    const CurveWindow& window = windows[static_cast<size_t>(cap ? (k == 0 ? 1 : k - 1) : k)];
+    const CurveWindow& window = JudgingWindow(windows, static_cast<size_t>(k), d);
     if (window.residual_rms.size() != d) continue;
     const Eigen::Index a = std::max<Eigen::Index>(0, k - kPooledWindows), b = std::min(count - 1, k + kPooledWindows);
     const double pooled = samples.segment(a, b - a + 1).sum();
     if (pooled < kMinHeldOut) continue;
     const double mean_inverse_h2 = inverse_h2.segment(a, b - a + 1).sum() / pooled;
-    const double m = window.samples;
     for (Eigen::Index c = 0; c < d; ++c) {
       const double departure = squares.col(c).segment(a, b - a + 1).sum() / pooled;
       const double noise = kSplineNoiseGain * sigma[c] * sigma[c] * mean_inverse_h2;
       const double spread = fourth.col(c).segment(a, b - a + 1).sum() / pooled - departure * departure;
       const double se = std::sqrt(std::max(0.0, spread) / pooled);
       if (!(departure - kDepartureMargin * se > 2.0 * noise)) continue;
-      const double p = window.degrees[static_cast<size_t>(c)] + 1.0;
-      if (!(m > p)) continue;
-      const double rr = window.residual_rms[c];
-      const double missed = m * m * rr * rr / ((m - p) * (m - p)) - sigma[c] * sigma[c] * m / (m - p);
-      departs[static_cast<size_t>(k * d + c)] = missed * std::numbers::pi * std::numbers::pi * mean_inverse_h2 >= departure - noise;
+      if (!(window.samples > window.degrees[static_cast<size_t>(c)] + 1)) continue;
+      const double missed = MissedMotion(window, c, sigma[c] * sigma[c]);
+      departs[static_cast<size_t>(k * d + c)] =
+          missed * std::numbers::pi * std::numbers::pi * mean_inverse_h2 >= departure - noise;
     }
   }
   return departs;
@@ -376,10 +386,7 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
   for (Eigen::Index i = 0; i < n; ++i) {
     const double ti = t[first + i];
     while (w + 1 < windows.size() && ti >= windows[w + 1].core_begin) ++w;
-    // An end cap (no residual test of its own) takes the verdict of the end window it was cut
-    // from: its samples are that window's, and where no cap fit helps it is that window's polynomial.
-    const bool cap = windows[w].lack_of_fit.size() != d && windows.size() > 1 && (w == 0 || w + 1 == windows.size());
-    const CurveWindow& window = cap ? windows[w == 0 ? 1 : w - 1] : windows[w];
+    const CurveWindow& window = JudgingWindow(windows, w, d);
     if (window.lack_of_fit.size() != d) continue;
     const bool unresolved = window.verdict == WindowVerdict::kUnresolved;
     for (Eigen::Index c = 0; c < d; ++c) {
@@ -389,8 +396,8 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
       const bool interpolates = window.samples - window.degrees[static_cast<size_t>(c)] - 1 <= 0;
       const double dof = window.samples - window.degrees[static_cast<size_t>(c)] - 1.0;
       const double variance = window.residual_rms[c] * window.residual_rms[c] * window.samples / std::max(dof, 1.0);
-      const bool missed = window.lack_of_fit[c] > lack_of_fit_limit && variance >= 2.0 * sigma[c] * sigma[c];
-      local(i, c) = (unresolved && (interpolates || missed || departs[static_cast<size_t>(k * d + c)])) ||
+      const bool misses_motion = window.lack_of_fit[c] > lack_of_fit_limit && variance >= 2.0 * sigma[c] * sigma[c];
+      local(i, c) = (unresolved && (interpolates || misses_motion || departs[static_cast<size_t>(k * d + c)])) ||
                     rates.under_resolved(k, c);
       five(i, c) = rates.stencil(k, c) == 5;
       spline(i, c) = rates.stencil(k, c) == kSpline;
