@@ -145,7 +145,7 @@ double EndRate(double h_near, double d_near, double h_far, double d_far) {
   return d_near - h_near * (d_far - d_near) / (h_near + h_far);
 }
 
-// What window missed in coordinate c, at least: its generalised cross-validation error
+// What the window missed in coordinate c, at least: its generalised cross-validation error
 // m·RSS/(m − p)² (p = N + 1 coefficients) less what noise of variance `noise` gives it, σ²·m/(m − p).
 double MissedMotion(const CurveWindow& window, Eigen::Index c, double noise) {
   const double m = window.samples, p = window.degrees[static_cast<size_t>(c)] + 1.0;
@@ -342,8 +342,9 @@ std::vector<bool> DepartsFromSpline(const Eigen::VectorXd& t, Eigen::Index first
     inverse_h2[w] += 1.0 / (h * h);
   }
   for (Eigen::Index k = 0; k < count; ++k) {
+    // Only an unresolved window's samples can go to the local rate (LocalRuns).
     const CurveWindow& window = JudgingWindow(windows, static_cast<size_t>(k), d);
-    if (window.residual_rms.size() != d) continue;
+    if (window.verdict != WindowVerdict::kUnresolved || window.residual_rms.size() != d) continue;
     const Eigen::Index a = std::max<Eigen::Index>(0, k - kPooledWindows), b = std::min(count - 1, k + kPooledWindows);
     const double pooled = samples.segment(a, b - a + 1).sum();
     if (pooled < kMinHeldOut) continue;
@@ -393,8 +394,8 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
       const auto k = static_cast<Eigen::Index>(w);
       // An unresolved window that interpolates its samples (no freedom left for the residual test)
       // shows nothing better than the samples' own interpolant, whose rate is far better conditioned.
-      const bool interpolates = window.samples - window.degrees[static_cast<size_t>(c)] - 1 <= 0;
       const double dof = window.samples - window.degrees[static_cast<size_t>(c)] - 1.0;
+      const bool interpolates = dof <= 0.0;
       const double variance = window.residual_rms[c] * window.residual_rms[c] * window.samples / std::max(dof, 1.0);
       const bool misses_motion = window.lack_of_fit[c] > lack_of_fit_limit && variance >= 2.0 * sigma[c] * sigma[c];
       local(i, c) = (unresolved && (interpolates || misses_motion || departs[static_cast<size_t>(k * d + c)])) ||
