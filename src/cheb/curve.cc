@@ -165,7 +165,7 @@ class WindowFitter {
     bool arbitrate = !resolved && may_split && undecided != nullptr && cross_validate && options_.lack_of_fit;
     if (cross_validate && (resolved || !may_split || arbitrate)) {
       Eigen::VectorXd error;
-      window.degrees = CrossValidatedDegrees(*folds, top, &error);
+      window.degrees = CrossValidatedDegrees(*folds, top, SearchReach(window.degrees, top), &error);
       if (held_out != nullptr) *held_out = error / static_cast<double>(m);
       if (arbitrate) {
         Eigen::RowVectorXd spread = Eigen::RowVectorXd::Zero(d);
@@ -510,15 +510,27 @@ class WindowFitter {
     return folds;
   }
 
+  // The highest degree the cross-validation of a window of top degree `top` tries, given the
+  // degrees standardChop kept (`chopped`, the top where it found no plateau): twice the highest
+  // plus 2. Above a plateau's start the coefficients are noise, which the held-out error of a
+  // higher degree only matches by chance, and the folds' factorisations cost the cube of the
+  // reach: the 37,500-sample windows of the 100k drone file (top 400, plateaus from 88 to 123,
+  // cross-validated degrees 89 to 139) no longer factorise at 400 (docs/velocity.md, item 5 of
+  // "Linear velocity").
+  static int SearchReach(const std::vector<int>& chopped, int top) {
+    return std::min(top, 2 * *std::max_element(chopped.begin(), chopped.end()) + 2);
+  }
+
   // 5-fold cross-validation over a geometric grid of degrees up to `top`, per coordinate: the
   // degree of least held-out squared error. Nothing is evaluated point by point: with F_f the
   // normal equations (G_f, b_f) and Σz² of fold f, the training system of fold f is Σ F - F_f,
   // and the held-out error of coefficients c is Σz²_f - 2 cᵀb_f + cᵀG_f c. Each fold's training
   // system is factorised once; each candidate degree is then two triangular solves of a leading
-  // block.
-  static std::vector<int> CrossValidatedDegrees(const Folds& folds, int top, Eigen::VectorXd* best_error) {
-    const std::vector<int> grid = DegreeGrid(top);
-    const Eigen::MatrixXd error = HeldOutErrors(folds, grid, top);
+  // block. The grid stops at `reach` (its first degree is always tried).
+  static std::vector<int> CrossValidatedDegrees(const Folds& folds, int top, int reach, Eigen::VectorXd* best_error) {
+    std::vector<int> grid = DegreeGrid(top);
+    grid.erase(std::upper_bound(grid.begin() + 1, grid.end(), reach), grid.end());
+    const Eigen::MatrixXd error = HeldOutErrors(folds, grid, grid.back());
     const Eigen::Index d = error.cols();
     std::vector<int> degrees(static_cast<size_t>(d));
     best_error->resize(d);
