@@ -161,6 +161,29 @@ TEST(EstimateNoiseSigma, HigherOrdersLookPastMotionInTheUpperBand) {
   }
 }
 
+// Motion at a quarter of the rate (a 1 mm tone at 25 Hz, sampled at 100 Hz) reaches the 4th
+// differences by (2 sin(π/4))⁸ = 16 in power: under 0.5 mm of noise they read ~0.6 mm. The 6th
+// and 8th read it 2 and 4 times less, and white noise leaves them at σ; their drop (~10-15 %) is
+// well above white noise's scatter between the orders at m = 2000 (~1.5-2 %), though not below
+// 0.8 of the 4th's, which is what the estimate once needed.
+TEST(EstimateNoiseSigma, HigherOrdersLookPastMotionAtAQuarterOfTheRate) {
+  const Eigen::Index m = 2000;
+  const double sigma = 5e-4;
+  for (const uint64_t seed : {21u, 22u, 23u}) {
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> noise(0.0, sigma);
+    Eigen::VectorXd t(m);
+    Eigen::MatrixXd z(m, 1);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      t[i] = static_cast<double>(i) * 0.01;
+      z(i, 0) = 1e-3 * std::sin(2.0 * M_PI * 25.0 * t[i] + 0.3) + 0.2 * std::sin(0.5 * t[i]) + noise(rng);
+    }
+    const double fourth = EstimateNoiseSigma(z)[0], estimate = EstimateNoiseSigma(t, z)[0];
+    EXPECT_GT(fourth, 1.1 * sigma) << "seed " << seed;
+    EXPECT_NEAR(estimate, sigma, 0.08 * sigma) << "seed " << seed;
+  }
+}
+
 // Robust: 1 % of the samples replaced by 1 m outliers (each spoils 5 of the differences, so ~5 %
 // of them) moves the median only slightly, where a standard deviation would be ~1000x too large.
 TEST(EstimateNoiseSigma, OutliersBarelyMoveTheEstimate) {

@@ -35,8 +35,11 @@ Eigen::VectorXd EstimateNoiseSigma(const Eigen::Ref<const Eigen::MatrixXd>& z, i
 /// Motion in the upper part of the band also reaches the 4th differences (by (2 sin(ωh/2))⁴, where
 /// noise gains 70): the same estimate from the 6th and then the 8th divided differences (7 and 9
 /// samples), which white noise leaves at σ while such motion falls by (2 sin(ωh/2))² per order,
-/// replaces it each time it is below 0.8 of it. At a twelfth of the sampling rate, noise-free
-/// motion read as 25 µm of noise by the 4th differences reads as 0.3 µm.
+/// replaces it (the lower of the two when both do) where it is below the 4th's by more than six
+/// standard deviations of white noise's scatter between the orders (0.67/sqrt(m) for the 6th,
+/// 0.90/sqrt(m) for the 8th, m samples), and wherever it is below 0.8 of it. At a twelfth of the
+/// sampling rate, noise-free motion read as 25 µm of noise by the 4th differences reads as 0.3 µm;
+/// at a quarter, 0.5 mm of noise read as 0.65 mm reads as 0.54 mm.
 Eigen::VectorXd EstimateNoiseSigma(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
                                    const std::vector<Eigen::Index>& breaks = {});
 
