@@ -1,7 +1,6 @@
 #include "local_rates.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -19,15 +18,8 @@ constexpr Eigen::Index kBlock = 64;
 constexpr double kMinHeldOut = 8;
 // UnderResolvedRates' code for the interpolating spline's slopes.
 constexpr int kSpline = 9;
-// The variances over σ²/h² of white noise's rates at even spacing: the 3-point rate's (1/2), the
-// 5-point rate's (130/144) and the interpolating cubic spline's slopes', and those of the 3-point
-// and the 5-point rate's differences from the spline's slopes ((1/π)∫|H_a − H_s|² over [0, π], H
-// the rates' transfer functions sin x, (8 sin x − sin 2x)/6 and 3 sin x/(2 + cos x)).
-constexpr double kThreeNoiseGain = 0.5;
-constexpr double kFiveNoiseGain = 130.0 / 144.0;
+// The variance of the interpolating cubic spline's slopes over σ²/h² for white noise at even spacing.
 constexpr double kSplineNoiseGain = 1.392;
-constexpr double kThreeSplineGain = 0.285;
-constexpr double kFiveSplineGain = 0.0797;
 // Windows on either side of a window pooled into its departure from the spline's slopes: the
 // smallest windows' cores hold 15–25 samples, too few for a mean square to decide by.
 constexpr Eigen::Index kPooledWindows = 2;
@@ -171,11 +163,11 @@ const CurveWindow& JudgingWindow(const std::vector<CurveWindow>& windows, size_t
   return cap ? windows[w == 0 ? 1 : w - 1] : windows[w];
 }
 
-// The weights of the derivative at sample i of the polynomial through samples lo .. hi (distinct
-// stamps; i among them; at most 8 samples): the rate is Σ weights[j − lo]·z_j.
-std::array<double, 8> LagrangeRateWeights(const Eigen::VectorXd& t, Eigen::Index i, Eigen::Index lo, Eigen::Index hi) {
-  std::array<double, 8> weights{};
-  double own = 0.0;
+// The derivative at sample i of the polynomial through samples lo .. hi (distinct stamps; i among
+// them): the quartic through i − 2 .. i + 2 in the interior, one-sided at a segment's end.
+double LagrangeRate(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index i, Eigen::Index c, Eigen::Index lo,
+                    Eigen::Index hi) {
+  double rate = 0.0, own = 0.0;
   for (Eigen::Index j = lo; j <= hi; ++j) {
     if (j == i) continue;
     own += 1.0 / (t[i] - t[j]);
@@ -183,54 +175,10 @@ std::array<double, 8> LagrangeRateWeights(const Eigen::VectorXd& t, Eigen::Index
     for (Eigen::Index l = lo; l <= hi; ++l) {
       if (l != j && l != i) weight *= (t[i] - t[l]) / (t[j] - t[l]);
     }
-    weights[static_cast<size_t>(j - lo)] = weight;
+    rate += weight * z(j, c);
   }
-  weights[static_cast<size_t>(i - lo)] = own;
-  return weights;
+  return rate + own * z(i, c);
 }
-
-// The rate of coordinate c at sample i from LagrangeRateWeights (the sample's own term last).
-double WeightedRate(const std::array<double, 8>& weights, const Eigen::MatrixXd& z, Eigen::Index i, Eigen::Index c,
-                    Eigen::Index lo, Eigen::Index hi) {
-  double rate = 0.0;
-  for (Eigen::Index j = lo; j <= hi; ++j) {
-    if (j != i) rate += weights[static_cast<size_t>(j - lo)] * z(j, c);
-  }
-  return rate + weights[static_cast<size_t>(i - lo)] * z(i, c);
-}
-
-// The derivative at sample i of the polynomial through samples lo .. hi (distinct stamps; i among
-// them): the quartic through i − 2 .. i + 2 in the interior, one-sided at a segment's end.
-double LagrangeRate(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index i, Eigen::Index c, Eigen::Index lo,
-                    Eigen::Index hi) {
-  return WeightedRate(LagrangeRateWeights(t, i, lo, hi), z, i, c, lo, hi);
-}
-
-// The fractions of a tone's rate that the 3-point rate, the 5-point rate and the spline's slopes
-// lose at ωh = x (even spacing): 1 − sin x/x, 1 − (8 sin x − sin 2x)/(6x), 1 − 3 sin x/(x(2 + cos x)).
-struct LostFractions {
-  double f3, f5, fs;
-  static LostFractions At(double x) {
-    return {1.0 - std::sin(x) / x, 1.0 - (8.0 * std::sin(x) - std::sin(2.0 * x)) / (6.0 * x),
-            1.0 - 3.0 * std::sin(x) / (x * (2.0 + std::cos(x)))};
-  }
-  // The fractions at the ωh where ((f5 − fs)/(f3 − fs))² is `ratio` (it rises with ωh up to 2.9,
-  // where the search stops, and at 0.01, where the fractions are below 2e-5).
-  static LostFractions FromRatio(double ratio) {
-    auto of = [](double x) {
-      const LostFractions f = At(x);
-      return (f.f5 - f.fs) * (f.f5 - f.fs) / ((f.f3 - f.fs) * (f.f3 - f.fs));
-    };
-    double lo = 1e-2, hi = 2.9;
-    if (!(ratio > of(lo))) return At(lo);
-    if (ratio >= of(hi)) return At(hi);
-    for (int step = 0; step < 40; ++step) {
-      const double middle = 0.5 * (lo + hi);
-      (of(middle) < ratio ? lo : hi) = middle;
-    }
-    return At(0.5 * (lo + hi));
-  }
-};
 
 }  // namespace
 
@@ -261,8 +209,8 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
                                        : Eigen::VectorXd();
   const bool distinct = n >= 3 && (steps.array() > 0.0).all();
   Eigen::MatrixXd spline_rates, three_rates;
-  Eigen::MatrixXd departures = Eigen::MatrixXd::Zero(count, d), departures5 = Eigen::MatrixXd::Zero(count, d);
-  Eigen::VectorXd counted = Eigen::VectorXd::Zero(count), counted5 = Eigen::VectorXd::Zero(count);
+  Eigen::MatrixXd departures = Eigen::MatrixXd::Zero(count, d);
+  Eigen::VectorXd counted = Eigen::VectorXd::Zero(count);
   if (distinct) {
     spline_rates.resize(n, d);
     three_rates.resize(n, d);
@@ -285,17 +233,6 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
     if (distinct) {
       departures.row(w) += (three_rates.row(i) - spline_rates.row(i)).cwiseAbs2();
       counted[w] += 1.0;
-      if (i >= 2 && i + 2 < n) {  // the 5-point rate (the quartic's derivative)
-        const Eigen::Index j = first + i;
-        const std::array<double, 8> weights = even ? std::array<double, 8>{} : LagrangeRateWeights(t, j, j - 2, j + 2);
-        for (Eigen::Index c = 0; c < d; ++c) {
-          const double* y = z.col(c).data() + j;
-          const double five = even ? (y[-2] - 8.0 * y[-1] + 8.0 * y[1] - y[2]) / (12.0 * steps[0])
-                                   : WeightedRate(weights, z, j, c, j - 2, j + 2);
-          departures5(w, c) += (five - spline_rates(i, c)) * (five - spline_rates(i, c));
-        }
-        counted5[w] += 1.0;
-      }
     }
     double gain[kOrders];
     bool all = i >= kOrders + 1 && i + kOrders + 1 < n;
@@ -352,37 +289,25 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
       // Σw² = 130/(144h²), fraction 1 − (8 sin(ωh) − sin(2ωh))/(6ωh).
       const double motion = std::max(0.0, cubic - noise * gains(k, 0)) / used[k];
       const double scale = 6.0 / (u * u) * frequency, inverse_h2 = spacing[k] / used[k];
+      const double bias3 = scale * (1.0 - std::sin(omega_h) / omega_h);
+      const double bias5 = scale * (1.0 - (8.0 * std::sin(omega_h) - std::sin(2.0 * omega_h)) / (6.0 * omega_h));
       // The interpolating cubic spline's slopes (C² at the samples): Σw² = 1.392/h², fraction
       // 1 − 3 sin(ωh)/(ωh(2 + cos ωh)).
-      const LostFractions lost = LostFractions::At(omega_h);
-      const double bias3 = scale * lost.f3, bias5 = scale * lost.f5, bias_spline = scale * lost.fs;
-      const double error3 = noise * kThreeNoiseGain * inverse_h2 + motion * bias3 * bias3;
-      const double error5 = noise * kFiveNoiseGain * inverse_h2 + motion * bias5 * bias5;
-      const double error_spline = noise * kSplineNoiseGain * inverse_h2 + motion * bias_spline * bias_spline;
+      const double bias_spline = scale * (1.0 - 3.0 * std::sin(omega_h) / (omega_h * (2.0 + std::cos(omega_h))));
+      const double error3 = noise * 0.5 * inverse_h2 + motion * bias3 * bias3;
+      const double error5 = noise * 130.0 / 144.0 * inverse_h2 + motion * bias5 * bias5;
+      const double error_spline = noise * 1.392 * inverse_h2 + motion * bias_spline * bias_spline;
       const double best = std::min({error3, error5, error_spline});
       rates.stencil(k, c) = best == error_spline ? kSpline : best == error5 ? 5 : 3;
-      // Where the model prefers the 3-point rate, the rates' differences from the spline's slopes
-      // may still say otherwise: the model reads motion near a quarter of the rate with a spread
-      // spectrum as noise. Their mean squares less their noise (kThreeSplineGain and
-      // kFiveSplineGain σ²/h²) are (f − f_s)² times the motion's squared rate for a tone, f the
-      // fraction of its rate each loses (LostFractions); their ratio gives the tone's ωh, which
-      // scales each rate's bias, and the rate of least bias² plus noise is taken. The noise is the
-      // lesser of σ² and the model's (both take in such motion, each its own way). At a quarter
-      // of the rate the 5-point rate loses 15 % of a tone's rate against the 3-point rate's 36 %,
-      // with 1.8x its noise and 0.65x the spline's.
-      if (rates.stencil(k, c) == 3 && counted[k] > 0.0 && counted5[k] > 0.0) {
-        const double noise_h2 = std::min(sigma[c] * sigma[c], noise) * inverse_h2;
-        const double b3 = departures(k, c) / counted[k] - kThreeSplineGain * noise_h2;
-        if (b3 > 0.0) {
-          const double b5 = std::max(0.0, departures5(k, c) / counted5[k] - kFiveSplineGain * noise_h2);
-          const LostFractions tone = LostFractions::FromRatio(b5 / b3);
-          const double rate2 = b3 / ((tone.f3 - tone.fs) * (tone.f3 - tone.fs));
-          const double e3 = tone.f3 * tone.f3 * rate2 + kThreeNoiseGain * noise_h2;
-          const double e5 = tone.f5 * tone.f5 * rate2 + kFiveNoiseGain * noise_h2;
-          const double es = tone.fs * tone.fs * rate2 + kSplineNoiseGain * noise_h2;
-          const double least = std::min({e3, e5, es});
-          rates.stencil(k, c) = least == e3 ? 3 : least == es ? kSpline : 5;
-        }
+      // Where the model prefers the 3-point rate, the samples may still say otherwise: its bias
+      // less the spline's is at least their difference, whose noise is σ²·0.285/h² at even
+      // spacing; the spline's slopes are better when its extra noise, σ²·(1.392 − 0.5)/h², is below
+      // that bias (mean difference² above σ²·1.177/h²; pure noise reaches it with probability
+      // ~1e-5 over 10 independent samples). The model reads motion near a quarter of the rate
+      // with a spread spectrum as noise.
+      if (rates.stencil(k, c) == 3 && counted[k] > 0.0 &&
+          departures(k, c) / counted[k] > 1.177 * sigma[c] * sigma[c] * inverse_h2) {
+        rates.stencil(k, c) = kSpline;
       }
       rates.under_resolved(k, c) = falls && above && missed > 0.0 && missed * frequency * frequency > best;
     }

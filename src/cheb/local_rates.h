@@ -29,10 +29,10 @@ struct LocalRates {
 /// u·(6/20)² and u·(20/70)² from each order to the next for motion of frequency ω,
 /// u = (2 sin(ωh/2))², which gives ω (white noise keeps them level; the degree-7 error bounds the
 /// noise). The stencil is the rate whose error by that model, its noise plus its bias at ω, is
-/// least; where that is the 3-point rate, the 3- and 5-point rates' mean squared differences from
-/// the spline's slopes, less their noise, give the biases (their ratio a tone's ω), and the rate
-/// of least bias² plus noise (the lesser of `sigma`² and the model's) is taken: the model reads a
-/// spread spectrum near a quarter of the rate as noise. The samples under-resolve the motion (this needs no σ) when both falls are by more
+/// least; where that is the 3-point rate, the spline's slopes replace it when the mean squared
+/// difference between the two exceeds 1.177·σ²/h² (`sigma` the noise per coordinate): the model
+/// reads a spread spectrum near a quarter of the rate as noise, and σ too can only make this test
+/// stricter. The samples under-resolve the motion (this needs no σ) when both falls are by more
 /// than half, ω lies above the 2N/span the window resolves, and the rate error of the missed
 /// motion, ω² times the window's generalised cross-validation error less its noise, exceeds the
 /// model's least. docs/velocity.md, "Local interpolant".
