@@ -427,7 +427,7 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
     // several times the centred one's of the same order, and one order more makes up for it. Only
     // over evenly spaced samples (steps within kOneSidedSpread of each other): across a gap the
     // quintic carries the far samples' curvature back to the end sample (a TUM fr2/desk ground
-    // truth's sample before a 43 ms gap: 4.7 m/s against a motion of 0.2 m/s).
+    // truth's samples beside holes of 20–300 ms: 9.5, 5.0 and 16.8 m/s against a motion under 1 m/s).
     const bool higher = five(i, c) || spline(i, c);
     auto even = [&](Eigen::Index from) {
       const auto steps = h.segment(from, kOneSided);
