@@ -1,8 +1,8 @@
 // Velocity-from-positions accuracy, the table of docs/velocity.md. For every synthetic kind at
-// noise 0, 0.5 mm and 2 mm, and for the real EuRoC ground truths of ../shared/data/ov_data
-// (velocity from positions against EuRoC's own velocity), the velocity RMSE over the FULL range
-// (ends included) of: cheval's automatic Chebyshev fit (default: 5-fold cross-validation per
-// window; the standardChop alternative beside it), central differences, Savitzky–Golay with the
+// noise 0, 0.5 mm and 2 mm, and for the real EuRoC ground truths of ../shared/data/ov_data and
+// DIDO's unevenly stamped motion capture (velocity from positions against each file's own
+// velocity), the velocity RMSE over the FULL range (ends included) of: cheval's automatic
+// Chebyshev fit (default: 5-fold cross-validation per window; the standardChop alternative beside it), central differences, Savitzky–Golay with the
 // best window of a grid (an oracle choice: it is told the truth), the running median of five
 // central differences, a cubic smoothing spline with GCV (smoothing_spline.h), and one global
 // Chebyshev fit of fixed degree 400 (the C-ASE paper's choice for CARLA). Besides the simulator's
@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -270,6 +271,22 @@ int main(int argc, char** argv) {
     }
     const traj::Trajectory gt = traj::ReadTrajectory(path);
     Print(Evaluate(std::string("EuRoC ") + file, gt.View(), gt.View().velocities()));
+  }
+  // DIDO's quadrotor flights: motion capture at ~410 Hz with uneven stamps (steps of 0.24–9 ms),
+  // against the dataset's own velocity.
+  for (const auto& [name, file] : {std::pair{"DIDO circle", "circle_a_1.5_v_2.5_r_1.5_2022-02-21-23-46-22.csv"},
+                                   std::pair{"DIDO eight", "eight_a_2.2_v_3.5_rx_1.8_2022-02-22-11-50-24.csv"}}) {
+    const std::string path = data + "/dido/csv/" + file;
+    if (!wanted(name)) continue;
+    if (!std::filesystem::exists(path)) {
+      std::printf("(missing %s)\n", path.c_str());
+      continue;
+    }
+    traj::ReadOptions options;
+    options.format = traj::Format::kCsv;
+    options.columns = traj::ColumnMap::Parse("t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz");
+    const traj::Trajectory gt = traj::ReadTrajectory(path, options);
+    Print(Evaluate(name, gt.View(), gt.View().velocities()));
   }
   if (only.empty()) AngularTable();
   return 0;
