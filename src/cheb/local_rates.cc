@@ -31,6 +31,10 @@ constexpr double kDepartureMargin = 1.0;
 // largest ratio of its steps it is used over.
 constexpr Eigen::Index kOneSided = 5;
 constexpr double kOneSidedSpread = 1.5;
+// A step shorter than this fraction of the shorter step beside it is close (Close): there the
+// quadratic that skips the close partner has 1/5 of the 3-point rate's noise variance; they are
+// equal near 0.8, and the wider stencil's bias on motion the windows missed grows with its span.
+constexpr double kCloseStep = 0.5;
 
 // The slopes of the cubic spline through (times, values) that are C² at rows a..b, given the
 // slopes at rows a − 1 and b + 1 (clamped): the tridiagonal system
@@ -67,6 +71,21 @@ constexpr double kEvenGains[3] = {70.0 / 36, 924.0 / 400, 12870.0 / 4900};
 // Each order's held-out error below this fraction of the one before: motion, not noise.
 constexpr double kUnderResolved = 0.5;
 
+// Whether step j (between samples j and j + 1 of a segment, `h` its steps) is shorter than
+// kCloseStep of the shorter step beside it: a slope over it carries the samples' noise over that
+// step, and the 3-point rate at either sample of such a pair takes it almost whole (Σw² of 2.9/h²
+// at a ratio of 1/2, h the longer step, and about 1/h_short² below; 1/(2h²) at even spacing); the
+// interpolating spline through them too. DIDO's motion capture, whose stamps alternate steps of
+// 0.24–0.7 ms with steps of 4–5 ms, was 20x its noise off at such pairs (docs/velocity.md, "Local
+// interpolant").
+bool Close(const Eigen::VectorXd& h, Eigen::Index j) {
+  const Eigen::Index n = h.size();
+  double beside = std::numeric_limits<double>::infinity();
+  if (j >= 1) beside = h[j - 1];
+  if (j + 1 < n) beside = std::min(beside, h[j + 1]);
+  return std::isfinite(beside) && h[j] > 0.0 && h[j] < kCloseStep * beside;
+}
+
 // Which slopes (between samples j and j + 1 of the segment, per coordinate) are not spikes.
 Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> UsableSlopes(const Eigen::VectorXd& h, const Eigen::MatrixXd& slopes,
                                                                 const Eigen::VectorXd& sigma) {
@@ -74,8 +93,9 @@ Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> UsableSlopes(const Eigen::Vec
   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> usable =
       Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, true);
   if (n < 3) return usable;
-  // Samples with equal stamps have no slope between them.
-  for (Eigen::Index j = 0; j < n; ++j) usable.row(j).setConstant(h[j] > 0.0);
+  // Samples with equal stamps have no slope between them, nor those much closer than their
+  // neighbours (Close).
+  for (Eigen::Index j = 0; j < n; ++j) usable.row(j).setConstant(h[j] > 0.0 && !Close(h, j));
   // Departures of the interior slopes (where all three exist), in units of the local scale.
   Eigen::MatrixXd departure = Eigen::MatrixXd::Zero(n, d);
   for (Eigen::Index j = 1; j + 1 < n; ++j) {
@@ -422,6 +442,15 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
     }
     const bool left = i >= 1 && usable(i - 1, c), right = i + 1 < n && usable(i, c);
     if (left && right) return CentredRate(h[i - 1], slopes(i - 1, c), h[i], slopes(i, c));
+    // Beside a close step (Close), the quadratic through the sample, its other neighbour and the
+    // sample past its close partner.
+    if (left && i + 2 < n && Close(h, i) && usable(i + 1, c)) {
+      return CentredRate(h[i - 1], slopes(i - 1, c), h[i] + h[i + 1], (z(first + i + 2, c) - z(first + i, c)) / (h[i] + h[i + 1]));
+    }
+    if (right && i >= 2 && Close(h, i - 1) && usable(i - 2, c)) {
+      return CentredRate(h[i - 2] + h[i - 1], (z(first + i, c) - z(first + i - 2, c)) / (h[i - 2] + h[i - 1]), h[i],
+                         slopes(i, c));
+    }
     // At a segment's end, where the window's stencil is of higher order than the quadratic's, the
     // quintic's through the end sample and the next five: a one-sided stencil's error constant is
     // several times the centred one's of the same order, and one order more makes up for it. Only
