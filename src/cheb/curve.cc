@@ -5,6 +5,7 @@
 #include "jumps.h"
 #include "local_rates.h"
 #include "local_regression.h"
+#include "noise_profile.h"
 
 #include <algorithm>
 #include <array>
@@ -55,9 +56,9 @@ using internal::kMaxGramCondition;
 // Fits one window and, for automatic degrees, says whether it should be split instead.
 class WindowFitter {
  public:
-  WindowFitter(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Eigen::VectorXd& sigma,
+  WindowFitter(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const internal::NoiseProfile& noise,
                const CurveOptions& options)
-      : t_(t), z_(z), sigma_(sigma), options_(options) {}
+      : t_(t), z_(z), noise_(noise), options_(options) {}
 
   // Fits the window of core [a, b] inside segment [segment_begin, segment_end]. Returns nullopt
   // when the series is not resolved and splitting is allowed.
@@ -102,7 +103,7 @@ class WindowFitter {
       std::fill(window.degrees.begin(), window.degrees.end(), options_.fixed_degree);
       window.series = FitLeastSquares(tw, zw, options_.fixed_degree, interval);
       window.coefficient_magnitudes = window.series.coefficients.cwiseAbs();
-      LackOfFit(tw, zw, WindowSigma(zw), &window);
+      LackOfFit(tw, zw, WindowSigma(noise_.Over(span.first, m), zw), &window);
       window.verdict = WindowVerdict::kFixedDegree;
       Finish(&window);
       return window;
@@ -113,8 +114,9 @@ class WindowFitter {
     // recording) is usually split: a subsample with N²/m = 2 (well conditioned, coefficient noise
     // still white) tells that at a fraction of the cost. Only its "unresolved" is trusted: a
     // subsample's noise plateau is higher, so it resolves no less than all the samples would.
+    const Eigen::VectorXd level = noise_.Over(span.first, m);
     const Eigen::Index stride = SubsampleStride(m, top);
-    if (may_split && stride >= 2 && !ResolvedOnSubsample(tw, zw, stride, top, interval)) return std::nullopt;
+    if (may_split && stride >= 2 && !ResolvedOnSubsample(tw, zw, level, stride, top, interval)) return std::nullopt;
     bool lowered = false;
     // Cross-validation needs the normal equations of each fold; their sum is the whole window's,
     // so the samples are visited once either way.
@@ -155,10 +157,10 @@ class WindowFitter {
     // plateau); it also picks the degree for kChop. Cross-validation picks the degree of a resolved
     // window for kCrossValidation: held-out error alone cannot tell an unresolved window (every
     // candidate underfits) from a resolved one.
-    bool resolved = ChopDegrees(high, m, &window.degrees);
+    bool resolved = ChopDegrees(high, m, level, &window.degrees);
     // The chop looks for a plateau by shape, which a short noisy window can hide: when the top third
     // of the coefficients is statistically pure noise, the window is resolved anyway.
-    const Eigen::VectorXd sigma = WindowSigma(zw);
+    const Eigen::VectorXd sigma = WindowSigma(level, zw);
     if (!resolved) resolved = TailIsNoise(high, *cholesky, sigma);
     if (held_out != nullptr) held_out->resize(0);
     // No plateau and a tail above the noise say that the window *may* miss motion above its top
@@ -226,16 +228,17 @@ class WindowFitter {
     const int top = TopDegree(span);
     const auto tw = t_.segment(span.first, span.count);
     const auto zw = z_.middleRows(span.first, span.count);
+    const Eigen::VectorXd level = noise_.Over(span.first, span.count);
     const Eigen::Index stride = SubsampleStride(span.count, top);
-    if (stride >= 2 && !ResolvedOnSubsample(tw, zw, stride, top, span.interval)) return false;
+    if (stride >= 2 && !ResolvedOnSubsample(tw, zw, level, stride, top, span.interval)) return false;
     const NormalEquations normal = BuildNormalEquations(tw, zw, top, span.interval);
     try {
       const NestedCholesky cholesky(normal, top);
       if (!(cholesky.Condition(top) <= kMaxGramCondition)) return false;
       const Eigen::MatrixXd high = cholesky.Solve(top, normal.rhs);
       std::vector<int> degrees(static_cast<size_t>(zw.cols()));
-      const Eigen::VectorXd sigma = WindowSigma(zw);
-      if (!ChopDegrees(high, span.count, &degrees) && !TailIsNoise(high, cholesky, sigma)) return false;
+      const Eigen::VectorXd sigma = WindowSigma(level, zw);
+      if (!ChopDegrees(high, span.count, level, &degrees) && !TailIsNoise(high, cholesky, sigma)) return false;
       const Centred centred = Centre(normal, zw);
       for (Eigen::Index c = 0; c < zw.cols(); ++c) {
         if (!(centred.LackOfFit(cholesky, top, c, span.count, sigma[c]) <= kSplitScore)) return false;
@@ -276,14 +279,16 @@ class WindowFitter {
     return false;
   }
 
-  // The noise σ per coordinate a window's samples `z` are tested against: the data's, floored at a
-  // rounding level of the values (1e-9 of their magnitude) so that exact data do not ask for an
-  // exact fit. Not the window's own estimate: a short window's scatters by tens of per cent, and
-  // taking the larger would let small unresolved motion pass as noise.
-  Eigen::VectorXd WindowSigma(const Eigen::Ref<const Eigen::MatrixXd>& z) const {
+  // The noise σ per coordinate a window's samples `z` are tested against: the noise profile's over
+  // them (`level`), floored at a rounding level of the values (1e-9 of their magnitude) so that
+  // exact data do not ask for an exact fit. Not the window's own estimate: a short window's
+  // scatters by tens of per cent, and taking the larger would let small unresolved motion pass as
+  // noise; the profile pools 160 samples and departs from the data's level only by a factor that
+  // scatter does not reach (internal::NoiseProfile).
+  static Eigen::VectorXd WindowSigma(const Eigen::VectorXd& level, const Eigen::Ref<const Eigen::MatrixXd>& z) {
     Eigen::VectorXd sigma(z.cols());
     for (Eigen::Index c = 0; c < z.cols(); ++c) {
-      sigma[c] = std::max(sigma_[c], 1e-9 * (1.0 + z.col(c).cwiseAbs().maxCoeff()));
+      sigma[c] = std::max(level[c], 1e-9 * (1.0 + z.col(c).cwiseAbs().maxCoeff()));
     }
     return sigma;
   }
@@ -371,9 +376,9 @@ class WindowFitter {
   }
 
   // Whether every `stride`-th sample resolves the window at degree `top` (true when that cannot
-  // be told: an ill-conditioned subsample).
+  // be told: an ill-conditioned subsample); `level` is the window's noise.
   bool ResolvedOnSubsample(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
-                           Eigen::Index stride, int top, const Interval& interval) const {
+                           const Eigen::VectorXd& level, Eigen::Index stride, int top, const Interval& interval) const {
     const Eigen::Index count = (t.size() + stride - 1) / stride;
     Eigen::VectorXd st(count);
     Eigen::MatrixXd sz(count, z.cols());
@@ -387,7 +392,7 @@ class WindowFitter {
       if (!(cholesky.Condition(top) <= kMaxGramCondition)) return true;
       const Eigen::MatrixXd high = cholesky.Solve(top, normal.rhs);
       std::vector<int> degrees(static_cast<size_t>(z.cols()));
-      return ChopDegrees(high, count, &degrees) || TailIsNoise(high, cholesky, WindowSigma(sz));
+      return ChopDegrees(high, count, level, &degrees) || TailIsNoise(high, cholesky, WindowSigma(level, sz));
     } catch (const ComputeError&) {
       return true;
     }
@@ -412,9 +417,11 @@ class WindowFitter {
   }
 
  private:
-  // standardChop on each coordinate of a probe fit `high` ((top + 1) x d) of m samples: the degree
-  // it keeps per coordinate, and whether every coordinate reached its noise plateau (resolved).
-  bool ChopDegrees(const Eigen::MatrixXd& high, Eigen::Index m, std::vector<int>* degrees) const {
+  // standardChop on each coordinate of a probe fit `high` ((top + 1) x d) of m samples whose noise
+  // is `level`: the degree it keeps per coordinate, and whether every coordinate reached its noise
+  // plateau (resolved).
+  static bool ChopDegrees(const Eigen::MatrixXd& high, Eigen::Index m, const Eigen::VectorXd& level,
+                          std::vector<int>* degrees) {
     const int top = static_cast<int>(high.rows()) - 1;
     bool resolved = true;
     for (Eigen::Index c = 0; c < high.cols(); ++c) {
@@ -427,7 +434,7 @@ class WindowFitter {
       (*degrees)[c] = 0;
       if (scale == 0.0) continue;  // a constant coordinate: degree 0
       // Noise level of a coefficient of m equispaced samples: σ·sqrt(2/m) (docs/velocity.md, "Formulas").
-      const double noise = sigma_[c] * std::sqrt(2.0 / static_cast<double>(m));
+      const double noise = level[c] * std::sqrt(2.0 / static_cast<double>(m));
       const double tol = std::clamp(noise / scale, kRoundingTolerance, 0.5);
       const int keep = StandardChop(coefficients, tol);
       // StandardChop needs 17 coefficients; below that, or without a plateau, it keeps all.
@@ -608,7 +615,7 @@ class WindowFitter {
 
   const Eigen::VectorXd& t_;
   const Eigen::MatrixXd& z_;
-  const Eigen::VectorXd& sigma_;
+  const internal::NoiseProfile& noise_;
   const CurveOptions& options_;
 };
 
@@ -899,9 +906,11 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   // Jumps and glitches (CurveOptions::robust): outliers leave the fit, jumps split it.
   internal::Jumps jumps;
   Eigen::VectorXd noise;  // of the samples split at the gaps
+  std::optional<internal::DifferenceMagnitudes> magnitudes;  // of the samples fitted, for their noise profile
   if (options.robust) {
+    if (!options.noise_sigma) magnitudes.emplace(t, z, gaps);
     noise = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
-                                : EstimateNoiseSigma(t, z, gaps);
+                                : magnitudes->Sigma(0, m);
     jumps = internal::FindJumps(t, z, gaps, noise);
   }
   std::vector<char> kept(static_cast<size_t>(m), 1);
@@ -964,10 +973,16 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
 
   // Taken again where the search found something (fewer samples, steps out, more cuts).
   const bool found = !jumps.outliers.empty() || !jumps.steps.empty() || !jumps.breaks.empty();
+  if (!options.noise_sigma && (found || !magnitudes)) magnitudes.emplace(t, z, cuts);
   curve.noise_sigma_ = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
                        : noise.size() > 0 && !found ? noise
-                                                    : EstimateNoiseSigma(t, z, cuts);
-  const WindowFitter fitter(t, z, curve.noise_sigma_, options);
+                                                    : magnitudes->Sigma(0, fitted_count);
+  // A noise σ given is taken everywhere; an estimated one is raised over stretches that are clearly
+  // noisier than the data as a whole.
+  const internal::NoiseProfile profile = magnitudes ? internal::NoiseProfile(curve.noise_sigma_, *magnitudes, fitted_count)
+                                                    : internal::NoiseProfile(curve.noise_sigma_);
+  magnitudes.reset();
+  const WindowFitter fitter(t, z, profile, options);
 
   // Segment boundaries [starts[k], starts[k+1]), with whether each segment ends at a jump; a
   // segment with one distinct stamp joins the neighbour across the shorter gap.
@@ -1043,7 +1058,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   if (options.lack_of_fit && adaptive) {
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
       local_rates.push_back(
-          internal::UnderResolvedRates(t, z, starts[k], starts[k + 1], curve.segments_[k], curve.noise_sigma_));
+          internal::UnderResolvedRates(t, z, starts[k], starts[k + 1], curve.segments_[k], profile));
       any_under_resolved = any_under_resolved || local_rates.back().under_resolved.any();
     }
   }
@@ -1055,7 +1070,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     }
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
       std::vector<LocalRun> runs = internal::LocalRuns(t, z, starts[k], starts[k + 1], curve.segments_[k],
-                                                       local_rates[k], fit_values, fit_rates, curve.noise_sigma_,
+                                                       local_rates[k], fit_values, fit_rates, profile,
                                                        kLackOfFitLimit);
       std::move(runs.begin(), runs.end(), std::back_inserter(curve.local_runs_));
     }
@@ -1071,8 +1086,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     std::vector<LocalRun> added;
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
       std::vector<LocalRun> runs = internal::LocalRegressionRuns(t, z, starts[k], starts[k + 1], curve.segments_[k],
-                                                                 fit_values, fit_rates, curve.noise_sigma_,
-                                                                 curve.local_runs_);
+                                                                 fit_values, fit_rates, profile, curve.local_runs_);
       std::move(runs.begin(), runs.end(), std::back_inserter(added));
     }
     std::move(added.begin(), added.end(), std::back_inserter(curve.local_runs_));

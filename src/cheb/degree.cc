@@ -1,5 +1,7 @@
 #include "cheval/cheb/degree.h"
 
+#include "noise_profile.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -89,16 +91,14 @@ constexpr double kRatioSpread8 = 0.90;
 constexpr double kDropDeviations = 6.0;
 constexpr double kMaxMotionDrop = 0.2;
 
-// The divided-difference estimate of EstimateNoiseSigma(t, z, breaks) from runs of kRun
-// consecutive samples (order kRun − 1; `cut` marks the boundaries a run may not cross): per
-// coordinate, 1.4826 · the median of |Σ w_j z_j| / sqrt(Σ w_j²) over the usable runs; zero where
-// there is none.
+// The magnitudes |Σ w_j z_j| / sqrt(Σ w_j²) of the divided differences of order kRun − 1 of runs
+// of kRun consecutive samples (`cut` marks the boundaries a run may not cross), by the run's first
+// sample and coordinate (m x d): NaN where no usable run starts.
 template <int kRun>
-Eigen::VectorXd DividedDifferenceSigma(const Eigen::Ref<const Eigen::VectorXd>& t,
-                                       const Eigen::Ref<const Eigen::MatrixXd>& z, const std::vector<char>& cut) {
+Eigen::MatrixXd DividedDifferenceMagnitudes(const Eigen::Ref<const Eigen::VectorXd>& t,
+                                            const Eigen::Ref<const Eigen::MatrixXd>& z, const std::vector<char>& cut) {
   const Eigen::Index m = z.rows(), d = z.cols();
-  std::vector<std::vector<double>> magnitudes(static_cast<size_t>(d));
-  for (auto& values : magnitudes) values.reserve(static_cast<size_t>(std::max<Eigen::Index>(m - kRun + 1, 0)));
+  Eigen::MatrixXd magnitudes = Eigen::MatrixXd::Constant(m, d, std::numeric_limits<double>::quiet_NaN());
   // Weights in a unit time scale (the run's span): only their ratio to their norm matters. A run
   // placed like the one before (to 1e-9 of its span: even sampling) keeps its weights.
   std::array<double, kRun> u{}, placed{}, w{};
@@ -131,40 +131,89 @@ Eigen::VectorXd DividedDifferenceSigma(const Eigen::Ref<const Eigen::VectorXd>& 
     for (Eigen::Index c = 0; c < d; ++c) {
       double sum = 0.0;
       for (int j = 1; j < kRun; ++j) sum += w[j] * (z(i + j, c) - z(i, c));  // Σ w_j = 0
-      magnitudes[static_cast<size_t>(c)].push_back(std::abs(sum) / norm);
+      magnitudes(i, c) = std::abs(sum) / norm;
     }
   }
-  Eigen::VectorXd sigma = Eigen::VectorXd::Zero(d);
-  for (Eigen::Index c = 0; c < d; ++c) {
-    std::vector<double>& values = magnitudes[static_cast<size_t>(c)];
-    if (values.empty()) continue;
-    auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), middle, values.end());
-    sigma[c] = 1.4826 * *middle;
+  return magnitudes;
+}
+
+// The factor from a median absolute value to a normal distribution's σ.
+constexpr double kMadScale = 1.4826;
+
+// kMadScale · the median of the magnitudes of rows [begin, end) of column c that are not NaN (zero
+// where there is none); `scratch` is reused.
+double ScaledMedian(const Eigen::MatrixXd& magnitudes, Eigen::Index begin, Eigen::Index end, Eigen::Index c,
+                    std::vector<double>* scratch) {
+  scratch->clear();
+  for (Eigen::Index i = begin; i < end; ++i) {
+    if (!std::isnan(magnitudes(i, c))) scratch->push_back(magnitudes(i, c));
   }
-  return sigma;
+  if (scratch->empty()) return 0.0;
+  auto middle = scratch->begin() + static_cast<std::ptrdiff_t>(scratch->size() / 2);
+  std::nth_element(scratch->begin(), middle, scratch->end());
+  return kMadScale * *middle;
 }
 
 }  // namespace
 
-Eigen::VectorXd EstimateNoiseSigma(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
-                                   const std::vector<Eigen::Index>& breaks) {
+namespace internal {
+
+DifferenceMagnitudes::DifferenceMagnitudes(const Eigen::Ref<const Eigen::VectorXd>& t,
+                                           const Eigen::Ref<const Eigen::MatrixXd>& z,
+                                           const std::vector<Eigen::Index>& breaks) {
   const Eigen::Index m = z.rows();
   std::vector<char> cut(static_cast<size_t>(std::max<Eigen::Index>(m, 1)), 0);
   for (const Eigen::Index b : breaks) {
     if (b >= 0 && b < m) cut[static_cast<size_t>(b)] = 1;
   }
-  const Eigen::VectorXd fourth = DividedDifferenceSigma<5>(t, z, cut);
-  const Eigen::VectorXd sixth = DividedDifferenceSigma<7>(t, z, cut), eighth = DividedDifferenceSigma<9>(t, z, cut);
-  const double root_m = std::sqrt(static_cast<double>(std::max<Eigen::Index>(m, 1)));
+  fourth_ = DividedDifferenceMagnitudes<5>(t, z, cut);
+  sixth_ = DividedDifferenceMagnitudes<7>(t, z, cut);
+  eighth_ = DividedDifferenceMagnitudes<9>(t, z, cut);
+}
+
+Eigen::VectorXd DifferenceMagnitudes::Sigma(Eigen::Index begin, Eigen::Index end) const {
+  return SigmaIfAbove(begin, end, Eigen::VectorXd::Constant(fourth_.cols(), -1.0));
+}
+
+Eigen::VectorXd DifferenceMagnitudes::SigmaIfAbove(Eigen::Index begin, Eigen::Index end,
+                                                   const Eigen::VectorXd& threshold) const {
+  const Eigen::Index d = fourth_.cols();
+  const double root_m = std::sqrt(static_cast<double>(std::max<Eigen::Index>(end - begin, 1)));
   const double keep6 = 1.0 - std::min(kMaxMotionDrop, kDropDeviations * kRatioSpread6 / root_m);
   const double keep8 = 1.0 - std::min(kMaxMotionDrop, kDropDeviations * kRatioSpread8 / root_m);
-  Eigen::VectorXd sigma = fourth;
-  for (Eigen::Index c = 0; c < sigma.size(); ++c) {
-    if (sixth[c] < keep6 * fourth[c]) sigma[c] = sixth[c];
-    if (eighth[c] < keep8 * fourth[c]) sigma[c] = std::min(sigma[c], eighth[c]);
+  Eigen::VectorXd sigma(d);
+  std::vector<double> scratch;
+  for (Eigen::Index c = 0; c < d; ++c) {
+    const double fourth = ScaledMedian(fourth_, begin, end, c, &scratch);
+    sigma[c] = fourth;
+    if (!(fourth > threshold[c])) continue;  // the higher orders only ever lower it
+    const double sixth = ScaledMedian(sixth_, begin, end, c, &scratch);
+    const double eighth = ScaledMedian(eighth_, begin, end, c, &scratch);
+    if (sixth < keep6 * fourth) sigma[c] = sixth;
+    if (eighth < keep8 * fourth) sigma[c] = std::min(sigma[c], eighth);
   }
   return sigma;
+}
+
+Eigen::MatrixXi DifferenceMagnitudes::CountsAbove(const Eigen::VectorXd& threshold) const {
+  const Eigen::Index m = fourth_.rows(), d = fourth_.cols();
+  Eigen::MatrixXi counts = Eigen::MatrixXi::Zero(m + 1, 2 * d);
+  for (Eigen::Index c = 0; c < d; ++c) {
+    for (Eigen::Index i = 0; i < m; ++i) {
+      const double v = fourth_(i, c);
+      const bool usable = !std::isnan(v);
+      counts(i + 1, 2 * c) = counts(i, 2 * c) + (usable ? 1 : 0);
+      counts(i + 1, 2 * c + 1) = counts(i, 2 * c + 1) + (usable && kMadScale * v > threshold[c] ? 1 : 0);
+    }
+  }
+  return counts;
+}
+
+}  // namespace internal
+
+Eigen::VectorXd EstimateNoiseSigma(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
+                                   const std::vector<Eigen::Index>& breaks) {
+  return internal::DifferenceMagnitudes(t, z, breaks).Sigma(0, z.rows());
 }
 
 }  // namespace cheval::cheb

@@ -1,5 +1,7 @@
 #include "local_rates.h"
 
+#include "noise_profile.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -86,9 +88,31 @@ bool Close(const Eigen::VectorXd& h, Eigen::Index j) {
   return std::isfinite(beside) && h[j] > 0.0 && h[j] < kCloseStep * beside;
 }
 
-// Which slopes (between samples j and j + 1 of the segment, per coordinate) are not spikes.
+// The first of the segment's n samples (from `first`) in each window's core, and n after the
+// last: a sample is the last window's whose core begins at or before it.
+std::vector<Eigen::Index> WindowStarts(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
+                                       const std::vector<CurveWindow>& windows) {
+  std::vector<Eigen::Index> starts(windows.size() + 1, n);
+  starts[0] = 0;
+  Eigen::Index i = 0;
+  for (size_t w = 1; w < windows.size(); ++w) {
+    while (i < n && t[first + i] < windows[w].core_begin) ++i;
+    starts[w] = i;
+  }
+  return starts;
+}
+
+// The noise σ per coordinate over the cores of windows a..b of a segment (`starts` its
+// WindowStarts).
+Eigen::VectorXd NoiseOver(const NoiseProfile& noise, Eigen::Index first, const std::vector<Eigen::Index>& starts,
+                          Eigen::Index a, Eigen::Index b) {
+  return noise.Over(first + starts[static_cast<size_t>(a)], starts[static_cast<size_t>(b + 1)] - starts[static_cast<size_t>(a)]);
+}
+
+// Which slopes (between samples j and j + 1 of the segment, from `first`, per coordinate) are not
+// spikes.
 Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> UsableSlopes(const Eigen::VectorXd& h, const Eigen::MatrixXd& slopes,
-                                                                const Eigen::VectorXd& sigma) {
+                                                                const NoiseProfile& noise, Eigen::Index first) {
   const Eigen::Index n = slopes.rows(), d = slopes.cols();
   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> usable =
       Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, true);
@@ -115,7 +139,7 @@ Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> UsableSlopes(const Eigen::Vec
       const double scale = 1.4826 * *middle;
       for (Eigen::Index j = begin; j < end; ++j) {
         if (!(h[j] > 0.0)) continue;
-        const double floor = std::sqrt(5.0) * sigma[c] / h[j];
+        const double floor = std::sqrt(5.0) * noise.Over(first + j, 2)[c] / h[j];
         const double s = std::max(scale, floor);
         score[j] = s > 0.0 ? std::abs(departure(j, c)) / s : 0.0;
       }
@@ -203,7 +227,7 @@ double LagrangeRate(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::I
 }  // namespace
 
 LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
-                              Eigen::Index last, const CurveSegment& segment, const Eigen::VectorXd& sigma) {
+                              Eigen::Index last, const CurveSegment& segment, const NoiseProfile& noise) {
   const Eigen::Index n = last - first, d = z.cols();
   const auto count = static_cast<Eigen::Index>(segment.windows.size());
   LocalRates rates{Eigen::ArrayXXi::Constant(count, d, 3),
@@ -279,11 +303,13 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
     const double h = 0.5 * (t[first + i + 1] - t[first + i - 1]);
     spacing[w] += 1.0 / (h * h);
   }
+  const std::vector<Eigen::Index> starts = WindowStarts(t, first, n, segment.windows);
   for (Eigen::Index k = 0; k < count; ++k) {
     const CurveWindow& window = segment.windows[static_cast<size_t>(k)];
     if (used[k] < kMinHeldOut || window.residual_rms.size() != d || window.degrees.size() != static_cast<size_t>(d)) {
       continue;
     }
+    const Eigen::VectorXd sigma = NoiseOver(noise, first, starts, k, k);
     const auto m = static_cast<double>(window.samples);
     const double span = window.fit_end - window.fit_begin, h = 1.0 / std::sqrt(spacing[k] / used[k]);
     for (Eigen::Index c = 0; c < d; ++c) {
@@ -343,7 +369,7 @@ namespace {
 // motion could hold that departure (LocalRuns).
 std::vector<bool> DepartsFromSpline(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
                                     const CurveSegment& segment, const LocalRates& rates,
-                                    const Eigen::MatrixXd& fit_rates, const Eigen::VectorXd& sigma) {
+                                    const Eigen::MatrixXd& fit_rates, const NoiseProfile& noise) {
   const std::vector<CurveWindow>& windows = segment.windows;
   const auto count = static_cast<Eigen::Index>(windows.size());
   const Eigen::Index d = fit_rates.cols();
@@ -363,6 +389,7 @@ std::vector<bool> DepartsFromSpline(const Eigen::VectorXd& t, Eigen::Index first
     samples[w] += 1.0;
     inverse_h2[w] += 1.0 / (h * h);
   }
+  const std::vector<Eigen::Index> starts = WindowStarts(t, first, n, windows);
   for (Eigen::Index k = 0; k < count; ++k) {
     // Only an unresolved window's samples can go to the local rate (LocalRuns).
     const CurveWindow& window = JudgingWindow(windows, static_cast<size_t>(k), d);
@@ -371,16 +398,18 @@ std::vector<bool> DepartsFromSpline(const Eigen::VectorXd& t, Eigen::Index first
     const double pooled = samples.segment(a, b - a + 1).sum();
     if (pooled < kMinHeldOut) continue;
     const double mean_inverse_h2 = inverse_h2.segment(a, b - a + 1).sum() / pooled;
+    const Eigen::VectorXd pooled_sigma = NoiseOver(noise, first, starts, a, b);
+    const Eigen::VectorXd sigma = NoiseOver(noise, first, starts, k, k);
     for (Eigen::Index c = 0; c < d; ++c) {
       const double departure = squares.col(c).segment(a, b - a + 1).sum() / pooled;
-      const double noise = kSplineNoiseGain * sigma[c] * sigma[c] * mean_inverse_h2;
+      const double spline_noise = kSplineNoiseGain * pooled_sigma[c] * pooled_sigma[c] * mean_inverse_h2;
       const double spread = fourth.col(c).segment(a, b - a + 1).sum() / pooled - departure * departure;
       const double se = std::sqrt(std::max(0.0, spread) / pooled);
-      if (!(departure - kDepartureMargin * se > 2.0 * noise)) continue;
+      if (!(departure - kDepartureMargin * se > 2.0 * spline_noise)) continue;
       if (!(window.samples > window.degrees[static_cast<size_t>(c)] + 1)) continue;
       const double missed = MissedMotion(window, c, sigma[c] * sigma[c]);
       departs[static_cast<size_t>(k * d + c)] =
-          missed * std::numbers::pi * std::numbers::pi * mean_inverse_h2 >= departure - noise;
+          missed * std::numbers::pi * std::numbers::pi * mean_inverse_h2 >= departure - spline_noise;
     }
   }
   return departs;
@@ -391,7 +420,7 @@ std::vector<bool> DepartsFromSpline(const Eigen::VectorXd& t, Eigen::Index first
 std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                 Eigen::Index last, const CurveSegment& segment, const LocalRates& rates,
                                 const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
-                                const Eigen::VectorXd& sigma, double lack_of_fit_limit) {
+                                const NoiseProfile& noise, double lack_of_fit_limit) {
   std::vector<LocalRun> runs;
   const Eigen::Index n = last - first, d = z.cols();
   if (n < 3 || segment.windows.empty()) return runs;
@@ -403,7 +432,10 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> five =
       Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, false);
   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> spline = five;
-  const std::vector<bool> departs = DepartsFromSpline(t, first, n, segment, rates, fit_rates, sigma);
+  const std::vector<bool> departs = DepartsFromSpline(t, first, n, segment, rates, fit_rates, noise);
+  const std::vector<Eigen::Index> starts = WindowStarts(t, first, n, windows);
+  Eigen::MatrixXd window_sigma(static_cast<Eigen::Index>(windows.size()), d);
+  for (Eigen::Index k = 0; k < window_sigma.rows(); ++k) window_sigma.row(k) = NoiseOver(noise, first, starts, k, k).transpose();
   size_t w = 0;
   bool any = false;
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -419,7 +451,8 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
       const double dof = window.samples - window.degrees[static_cast<size_t>(c)] - 1.0;
       const bool interpolates = dof <= 0.0;
       const double variance = window.residual_rms[c] * window.residual_rms[c] * window.samples / std::max(dof, 1.0);
-      const bool misses_motion = window.lack_of_fit[c] > lack_of_fit_limit && variance >= 2.0 * sigma[c] * sigma[c];
+      const double sigma = window_sigma(static_cast<Eigen::Index>(w), c);
+      const bool misses_motion = window.lack_of_fit[c] > lack_of_fit_limit && variance >= 2.0 * sigma * sigma;
       local(i, c) = (unresolved && (interpolates || misses_motion || departs[static_cast<size_t>(k * d + c)])) ||
                     rates.under_resolved(k, c);
       five(i, c) = rates.stencil(k, c) == 5;
@@ -434,7 +467,7 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
   for (Eigen::Index j = 0; j + 1 < n; ++j) {
     if (h[j] > 0.0) slopes.row(j) = (z.row(first + j + 1) - z.row(first + j)) / h[j];
   }
-  const auto usable = UsableSlopes(h, slopes, sigma);
+  const auto usable = UsableSlopes(h, slopes, noise, first);
   // The derivative at sample i of the quadratic through it and its neighbours, from usable slopes.
   auto rate = [&](Eigen::Index i, Eigen::Index c) {
     if (five(i, c) && i >= 2 && i + 2 < n && usable(i - 2, c) && usable(i - 1, c) && usable(i, c) && usable(i + 1, c)) {

@@ -10,6 +10,8 @@
 
 namespace cheval::cheb::internal {
 
+class NoiseProfile;
+
 /// Per window of a segment (rows) and coordinate (columns): the samples' local rate, 3 (the
 /// derivative of the quadratic through a sample and its neighbours), 5 (of the quartic through it
 /// and two neighbours on either side) or 9 (the slopes of the cubic spline through the samples),
@@ -37,7 +39,7 @@ struct LocalRates {
 /// motion, ω² times the window's generalised cross-validation error less its noise, exceeds the
 /// model's least. docs/velocity.md, "Local interpolant".
 LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
-                              Eigen::Index last, const CurveSegment& segment, const Eigen::VectorXd& sigma);
+                              Eigen::Index last, const CurveSegment& segment, const NoiseProfile& noise);
 
 /// The local runs of one segment. A sample is local in coordinate c when it lies in the core of
 /// a window accepted unresolved
@@ -76,6 +78,6 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
 std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                 Eigen::Index last, const CurveSegment& segment, const LocalRates& rates,
                                 const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
-                                const Eigen::VectorXd& sigma, double lack_of_fit_limit);
+                                const NoiseProfile& noise, double lack_of_fit_limit);
 
 }  // namespace cheval::cheb::internal

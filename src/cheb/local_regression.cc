@@ -1,5 +1,7 @@
 #include "local_regression.h"
 
+#include "noise_profile.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -336,7 +338,7 @@ bool RegressionMayGain(const CurveWindow& window) {
 std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                           Eigen::Index last, const CurveSegment& segment,
                                           const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
-                                          const Eigen::VectorXd& sigma, const std::vector<LocalRun>& taken) {
+                                          const NoiseProfile& noise, const std::vector<LocalRun>& taken) {
   std::vector<LocalRun> runs;
   const std::vector<CurveWindow>& windows = segment.windows;
   const Eigen::Index n = last - first, d = z.cols();
@@ -425,6 +427,7 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
     }
     std::vector<int> chosen(static_cast<size_t>(d), -1);
     bool replaced = false;
+    const Eigen::VectorXd sigma = noise.Over(first + s0, length);
     for (Eigen::Index c = 0; c < d; ++c) {
       chosen[static_cast<size_t>(c)] = scores.Choose(c, sigma[c]);
       replaced = replaced || chosen[static_cast<size_t>(c)] >= 0;

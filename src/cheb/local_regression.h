@@ -11,6 +11,8 @@
 
 namespace cheval::cheb::internal {
 
+class NoiseProfile;
+
 /// Whether the local regression is tried in a window's core: the window was split for missed
 /// motion, or it spends a coefficient on fewer samples than the widest candidate (53) spans, so
 /// its rate is as local as theirs. A window with more samples per coefficient is smoother than
@@ -42,6 +44,6 @@ bool RegressionMayGain(const CurveWindow& window);
 std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                           Eigen::Index last, const CurveSegment& segment,
                                           const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
-                                          const Eigen::VectorXd& sigma, const std::vector<LocalRun>& taken);
+                                          const NoiseProfile& noise, const std::vector<LocalRun>& taken);
 
 }  // namespace cheval::cheb::internal

@@ -1,0 +1,44 @@
+#include "noise_profile.h"
+
+#include <algorithm>
+
+namespace cheval::cheb::internal {
+
+NoiseProfile::NoiseProfile(const Eigen::VectorXd& level) : level_(level) {}
+
+NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitudes& magnitudes, Eigen::Index m)
+    : level_(level) {
+  const Eigen::Index d = level.size();
+  cumulative_ = Eigen::MatrixXd::Zero(m + 1, d);
+  const Eigen::VectorXd raise = kRaise * level;
+  // Where the 4th differences' median over a block's pool cannot exceed the raise (their counts
+  // say so), no median is taken.
+  const Eigen::MatrixXi counts = magnitudes.CountsAbove(raise);
+  for (Eigen::Index begin = 0; begin < m; begin += kBlock) {
+    const Eigen::Index end = std::min(m, begin + kBlock);
+    const Eigen::Index from = std::max<Eigen::Index>(0, begin - kPooledBlocks * kBlock);
+    const Eigen::Index to = std::min(m, end + kPooledBlocks * kBlock);
+    bool may_raise = false;
+    for (Eigen::Index c = 0; c < d; ++c) {
+      const int usable = counts(to, 2 * c) - counts(from, 2 * c), above = counts(to, 2 * c + 1) - counts(from, 2 * c + 1);
+      may_raise = may_raise || (usable > 0 && above >= usable - usable / 2);
+    }
+    const Eigen::VectorXd local = may_raise ? magnitudes.SigmaIfAbove(from, to, raise) : level;
+    Eigen::RowVectorXd variance = level.cwiseAbs2().transpose();
+    bool raised = false;
+    for (Eigen::Index c = 0; c < d; ++c) {
+      if (local[c] > kRaise * level[c]) variance[c] = local[c] * local[c], raised = true;
+    }
+    if (raised) raised_samples_ += end - begin;
+    for (Eigen::Index i = begin; i < end; ++i) cumulative_.row(i + 1) = cumulative_.row(i) + variance;
+  }
+  if (raised_samples_ == 0) cumulative_.resize(0, 0);
+}
+
+Eigen::VectorXd NoiseProfile::Over(Eigen::Index first, Eigen::Index count) const {
+  if (count <= 0 || cumulative_.size() == 0) return level_;
+  const Eigen::RowVectorXd sum = cumulative_.row(first + count) - cumulative_.row(first);
+  return (sum.transpose() / static_cast<double>(count)).cwiseMax(0.0).cwiseSqrt();
+}
+
+}  // namespace cheval::cheb::internal

@@ -1,0 +1,65 @@
+#pragma once
+// Internal to the cheb library: the noise level along a curve's samples. Real motion capture is
+// noisier over some stretches than others: the data's level, a median over all the samples, is
+// the quiet stretches' (docs/velocity.md, "Noise profile").
+
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace cheval::cheb::internal {
+
+/// The magnitudes of the 4th, 6th and 8th divided differences of every run of 5, 7 and 9
+/// consecutive samples (EstimateNoiseSigma(t, z, breaks), which is built on it in degree.cc),
+/// kept per run so that the estimate can be taken over any stretch of the samples.
+class DifferenceMagnitudes {
+ public:
+  DifferenceMagnitudes(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
+                       const std::vector<Eigen::Index>& breaks);
+
+  /// EstimateNoiseSigma's estimate from the runs that start at samples [begin, end).
+  Eigen::VectorXd Sigma(Eigen::Index begin, Eigen::Index end) const;
+  /// The same where it exceeds `threshold` (per coordinate); elsewhere a value no larger than
+  /// `threshold`: the 4th differences' estimate, which the higher orders only ever lower. A third
+  /// of the cost where a stretch is not noisier.
+  Eigen::VectorXd SigmaIfAbove(Eigen::Index begin, Eigen::Index end, const Eigen::VectorXd& threshold) const;
+  /// For telling where SigmaIfAbove can exceed `threshold` without a median: per coordinate c, the
+  /// number of usable runs starting before each sample (column 2c) and of those whose 4th
+  /// differences' scaled magnitude exceeds threshold[c] (column 2c + 1), (m + 1) x 2d. Over a
+  /// stretch of n usable runs, the 4th differences' estimate exceeds the threshold exactly when
+  /// n − ⌊n/2⌋ of them do.
+  Eigen::MatrixXi CountsAbove(const Eigen::VectorXd& threshold) const;
+
+ private:
+  Eigen::MatrixXd fourth_, sixth_, eighth_;  // m x d, NaN where no usable run starts
+};
+
+/// The noise σ per coordinate along the samples: the data's level, raised over blocks of
+/// kBlock samples whose own estimate, pooled over kPooledBlocks blocks on either side, exceeds it
+/// by more than kRaise (a factor the estimate's scatter over that many samples does not reach on
+/// stationary noise).
+class NoiseProfile {
+ public:
+  static constexpr Eigen::Index kBlock = 32;
+  static constexpr Eigen::Index kPooledBlocks = 2;
+  static constexpr double kRaise = 1.5;
+
+  /// The level everywhere.
+  explicit NoiseProfile(const Eigen::VectorXd& level);
+  /// The level, raised where the samples' `magnitudes` say they are noisier.
+  NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitudes& magnitudes, Eigen::Index m);
+
+  /// The root mean square of σ over samples [first, first + count), per coordinate.
+  Eigen::VectorXd Over(Eigen::Index first, Eigen::Index count) const;
+  /// The data's level.
+  const Eigen::VectorXd& level() const { return level_; }
+  /// Samples where σ exceeds the level in some coordinate.
+  Eigen::Index raised_samples() const { return raised_samples_; }
+
+ private:
+  Eigen::VectorXd level_;
+  Eigen::MatrixXd cumulative_;  // (m + 1) x d: Σ σ² over the samples before each row; empty: the level
+  Eigen::Index raised_samples_ = 0;
+};
+
+}  // namespace cheval::cheb::internal
