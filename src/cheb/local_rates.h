@@ -32,7 +32,7 @@ struct LocalRates {
 /// u = (2 sin(ωh/2))², which gives ω (white noise keeps them level; the degree-7 error bounds the
 /// noise). The stencil is the rate whose error by that model, its noise plus its bias at ω, is
 /// least; where that is the 3-point rate, the spline's slopes replace it when the mean squared
-/// difference between the two exceeds 1.177·σ²/h² (`sigma` the noise per coordinate): the model
+/// difference between the two exceeds 1.177·σ²/h² (σ the noise profile's over the window): the model
 /// reads a spread spectrum near a quarter of the rate as noise, and σ too can only make this test
 /// stricter. The samples under-resolve the motion (this needs no σ) when both falls are by more
 /// than half, ω lies above the 2N/span the window resolves, and the rate error of the missed
@@ -65,7 +65,10 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
 /// The rate at a local sample is its window's stencil in `rates`: the derivative of the quadratic
 /// through it and its two neighbours (one-sided at the segment's ends), of the quartic through it
 /// and two neighbours on either side, or the clamped cubic spline's slopes over stretches, from
-/// slopes between consecutive samples that are not isolated spikes: a slope whose departure from
+/// slopes between consecutive samples that are neither over a close step (shorter than half the
+/// shorter step beside it, whose rate would carry the pair's noise over it; the sample beside one
+/// takes the quadratic through its other neighbour and the sample past its partner) nor isolated
+/// spikes: a slope whose departure from
 /// the mean of its two neighbours is above 4 local scales (1.4826·median departure over 64 slopes,
 /// floored at the noise's sqrt(5)·σ/h), larger than its neighbours' and opposed by both (a step of
 /// the values moves the neighbours' departures the other way, smooth curvature moves them
@@ -74,7 +77,8 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
 ///
 /// `t` (sorted, s) and `z` (m x d, steps taken out) are the curve's fitted samples, [first, last)
 /// the segment's, `rates` its UnderResolvedRates, `fit_values` and `fit_rates` (m x d)
-/// the segment's fit at them, `sigma` the noise per coordinate.
+/// the segment's fit at them, `noise` the curve's noise profile (σ per window: its RMS over the
+/// window's core).
 std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                 Eigen::Index last, const CurveSegment& segment, const LocalRates& rates,
                                 const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,

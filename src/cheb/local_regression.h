@@ -39,8 +39,8 @@ bool RegressionMayGain(const CurveWindow& window);
 /// coordinates it replaces, the fit's elsewhere, and starts and ends on a sample of the fit.
 ///
 /// `t` (sorted, s) and `z` (m x d, steps taken out) are the curve's fitted samples, [first, last)
-/// the segment's, `fit_values` and `fit_rates` (m x d) the curve at them, `sigma` the noise per
-/// coordinate.
+/// the segment's, `fit_values` and `fit_rates` (m x d) the curve at them, `noise` the curve's noise
+/// profile (σ per stretch: its RMS over the stretch).
 std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                           Eigen::Index last, const CurveSegment& segment,
                                           const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
