@@ -982,6 +982,8 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   const internal::NoiseProfile profile = magnitudes ? internal::NoiseProfile(curve.noise_sigma_, *magnitudes, fitted_count)
                                                     : internal::NoiseProfile(curve.noise_sigma_);
   magnitudes.reset();
+  curve.noisier_samples_ = profile.raised_samples();
+  if (curve.noisier_samples_ > 0) curve.noise_sigma_max_ = profile.maximum();
   const WindowFitter fitter(t, z, profile, options);
 
   // Segment boundaries [starts[k], starts[k+1]), with whether each segment ends at a jump; a

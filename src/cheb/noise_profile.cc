@@ -4,10 +4,10 @@
 
 namespace cheval::cheb::internal {
 
-NoiseProfile::NoiseProfile(const Eigen::VectorXd& level) : level_(level) {}
+NoiseProfile::NoiseProfile(const Eigen::VectorXd& level) : level_(level), maximum_(level) {}
 
 NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitudes& magnitudes, Eigen::Index m)
-    : level_(level) {
+    : level_(level), maximum_(level) {
   const Eigen::Index d = level.size();
   cumulative_ = Eigen::MatrixXd::Zero(m + 1, d);
   const Eigen::VectorXd raise = kRaise * level;
@@ -27,7 +27,11 @@ NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitu
     Eigen::RowVectorXd variance = level.cwiseAbs2().transpose();
     bool raised = false;
     for (Eigen::Index c = 0; c < d; ++c) {
-      if (local[c] > kRaise * level[c]) variance[c] = local[c] * local[c], raised = true;
+      if (local[c] > kRaise * level[c]) {
+        variance[c] = local[c] * local[c];
+        maximum_[c] = std::max(maximum_[c], local[c]);
+        raised = true;
+      }
     }
     if (raised) raised_samples_ += end - begin;
     for (Eigen::Index i = begin; i < end; ++i) cumulative_.row(i + 1) = cumulative_.row(i) + variance;

@@ -55,9 +55,11 @@ class NoiseProfile {
   const Eigen::VectorXd& level() const { return level_; }
   /// Samples where σ exceeds the level in some coordinate.
   Eigen::Index raised_samples() const { return raised_samples_; }
+  /// The largest σ per coordinate (the level where nothing is raised).
+  const Eigen::VectorXd& maximum() const { return maximum_; }
 
  private:
-  Eigen::VectorXd level_;
+  Eigen::VectorXd level_, maximum_;
   Eigen::MatrixXd cumulative_;  // (m + 1) x d: Σ σ² over the samples before each row; empty: the level
   Eigen::Index raised_samples_ = 0;
 };

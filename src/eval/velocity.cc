@@ -305,6 +305,8 @@ std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimat
     j["degrees"] = degrees;
     j["window_list"] = windows;
     j["noise_sigma_m"] = std::vector<double>(curve.noise_sigma().data(), curve.noise_sigma().data() + 3);
+    j["noise_sigma_max_m"] = std::vector<double>(curve.noise_sigma_max().data(), curve.noise_sigma_max().data() + 3);
+    j["noisier_samples"] = curve.noisier_samples();
     j["residual_rmse_m"] = std::vector<double>(curve.residual_rms().data(), curve.residual_rms().data() + 3);
     j["compression_ratio"] = static_cast<double>(3 * run.input_poses) / static_cast<double>(curve.stored_values());
     j["unresolved_windows"] = curve.unresolved_windows();

@@ -263,6 +263,11 @@ TEST(EstimateVelocity, UnevenlyStampedMotionCaptureMatchesTheBestSavitzkyGolayWi
       return std::sqrt((EstimateVelocity(trajectory.View(), options).velocities - truth).colwise().squaredNorm().mean());
     };
     const double chebyshev = rms(VelocityOptions{});
+    // The noise profile found the noisier stretches in motion.
+    const VelocityEstimate estimate = EstimateVelocity(trajectory.View(), VelocityOptions{});
+    ASSERT_TRUE(estimate.curve.has_value());
+    EXPECT_GT(estimate.curve->noisier_samples(), trajectory.View().size() / 4) << file;
+    EXPECT_GT(estimate.curve->noise_sigma_max().maxCoeff(), 1.5 * estimate.curve->noise_sigma().maxCoeff()) << file;
     VelocityOptions central;
     central.method = VelocityMethod::kCentral;
     EXPECT_LT(chebyshev, 0.1 * rms(central)) << file;

@@ -90,10 +90,14 @@ void Run(const VelocityFlags& flags) {
       max_degree = std::max(max_degree, *std::max_element(w.degrees.begin(), w.degrees.end()));
     }
   }
-  fmt::print("{}: {} poses, {} windows in {} segments, degrees {}..{}, noise sigma {:.3g} m, residual RMSE "
+  const std::string noisier =
+      curve.noisier_samples() > 0
+          ? fmt::format(" (up to {:.3g} m over {} noisier samples)", curve.noise_sigma_max().maxCoeff(), curve.noisier_samples())
+          : std::string();
+  fmt::print("{}: {} poses, {} windows in {} segments, degrees {}..{}, noise sigma {:.3g} m{}, residual RMSE "
              "{:.3g} m, compression {:.1f}x, {:.3f} s\n",
              flags.input, view.size(), windows, curve.segments().size(), min_degree, max_degree,
-             curve.noise_sigma().mean(), curve.residual_rms().mean(),
+             curve.noise_sigma().mean(), noisier, curve.residual_rms().mean(),
              static_cast<double>(3 * view.size()) / static_cast<double>(curve.stored_values()), seconds);
 }
 

@@ -194,8 +194,13 @@ class Curve {
   int64_t origin_ns() const { return origin_ns_; }
   int dimension() const { return dimension_; }
   const std::vector<CurveSegment>& segments() const { return segments_; }
-  /// The noise σ per coordinate used to choose degrees (estimated or given).
+  /// The noise σ per coordinate used to choose degrees (estimated or given): the recording's level.
   const Eigen::VectorXd& noise_sigma() const { return noise_sigma_; }
+  /// Where stretches of the samples are clearly noisier than that level, the windows there were
+  /// tested against their own (docs/velocity.md, "Noise profile"): how many samples, and the
+  /// largest σ per coordinate (noise_sigma where none is).
+  Eigen::Index noisier_samples() const { return noisier_samples_; }
+  const Eigen::VectorXd& noise_sigma_max() const { return noise_sigma_max_.size() > 0 ? noise_sigma_max_ : noise_sigma_; }
   /// Root mean square of the fit residuals over the samples fitted (outliers left out), per coordinate.
   const Eigen::VectorXd& residual_rms() const { return residual_rms_; }
   /// Total number of stored values (Σ over windows of (degree + 1) per coordinate).
@@ -235,6 +240,8 @@ class Curve {
   int dimension_ = 0;
   std::vector<CurveSegment> segments_;
   Eigen::VectorXd noise_sigma_;
+  Eigen::Index noisier_samples_ = 0;
+  Eigen::VectorXd noise_sigma_max_;  // empty: noise_sigma_
   Eigen::VectorXd residual_rms_;
   std::vector<double> outlier_times_, jump_times_, step_times_;
   // Row k: the sum of the first k + 1 steps, added to values after step_times_[k].
