@@ -96,7 +96,13 @@ Raises ComputeError for a stamp outside the data by more than `tolerance` second
       .def_property_readonly("origin", &cheb::Curve::origin_ns, "Stamp (ns) of t = 0 of the windows' times.")
       .def_property_readonly("dimension", &cheb::Curve::dimension, "Coordinates per sample.")
       .def_property_readonly("noise_sigma", &cheb::Curve::noise_sigma,
-                             "Noise sigma per coordinate the degrees were chosen for (estimated or given).")
+                             "Noise sigma per coordinate the degrees were chosen for (estimated or given): the "
+                             "recording's level.")
+      .def_property_readonly("noise_sigma_max", &cheb::Curve::noise_sigma_max,
+                             "The largest noise sigma per coordinate of the noise profile (noise_sigma where no "
+                             "stretch is clearly noisier; docs/velocity.md, \"Noise profile\").")
+      .def_property_readonly("noisier_samples", &cheb::Curve::noisier_samples,
+                             "Samples tested against a noise sigma above the recording's (the noise profile).")
       .def_property_readonly("residual_rms", &cheb::Curve::residual_rms, "RMS of the fit residuals per coordinate.")
       .def_property_readonly("stored_values", &cheb::Curve::stored_values,
                              "Sum over windows of (degree + 1) per coordinate.")

@@ -134,6 +134,11 @@ class FitTest(unittest.TestCase):
         curve = cheval.fit(measured)
         self.assertLess(rmse(curve.evaluate(truth.stamps), truth.positions), 0.001)
         self.assertAlmostEqual(float(np.mean(curve.noise_sigma)), 0.001, delta=0.0002)
+        self.assertTrue(np.all(np.asarray(curve.noise_sigma_max) >= np.asarray(curve.noise_sigma)))
+        # Given, the noise is taken everywhere: nothing is raised.
+        given = cheval.fit(measured, noise=0.001)
+        self.assertEqual(given.noisier_samples, 0)
+        np.testing.assert_array_equal(given.noise_sigma_max, given.noise_sigma)
         self.assertGreater(len(curve.windows), 1)
         self.assertEqual(sum(len(w["degrees"]) for w in curve.windows), 3 * len(curve.windows))
 
