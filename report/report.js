@@ -330,7 +330,8 @@
     definitions(document.getElementById('fit-summary'), [
       ['windows', `${f.windows.length} in ${f.segments} gap-free segment(s)`],
       ['degrees', `${Math.min(...degrees)} .. ${Math.max(...degrees)}`],
-      ['noise σ (estimated)', f.noise_sigma.map((s) => s.toExponential(2) + ' m').join(', ')],
+      ['noise σ (estimated)', f.noise_sigma.map((s) => s.toExponential(2) + ' m').join(', ')
+        + (f.noisier_samples > 0 ? ` (up to ${f.noise_sigma_max.map((s) => s.toExponential(2)).join(', ')} m over ${f.noisier_samples} noisier samples)` : '')],
       ['fit residual RMS', f.residual_rms.map((s) => s.toExponential(2) + ' m').join(', ')],
       ['residual test', f.unresolved_windows === 0 ? 'every window passed'
         : `${f.unresolved_windows} window(s) failed at the smallest size; ${f.local_samples} samples followed by the local interpolant`],
@@ -352,8 +353,9 @@
         const at = tested.map((w) => (w.core_begin + w.core_end) / 2);
         const positive = (v) => (v > 0 ? v : null);
         const lines = axes.map((a, c) => ({ label: 'residual RMS ' + a, color: palette[c], x: at, y: tested.map((w) => positive(w.residual_rms[c])), points: true, width: 1 }));
-        axes.forEach((a, c) => lines.push({ label: 'noise σ ' + a, color: palette[c], dash: [5, 4], width: 1, x: at, y: at.map(() => positive(f.noise_sigma[c])) }));
-        lineChart(chartBox(row, 'fit-residual', 'Residual RMS per window against the noise σ'), { xLabel: timeLabel, yLabel: 'm', lines, log: true });
+        // Each window's σ is the noise profile's over its samples (the recording's where it has none).
+        axes.forEach((a, c) => lines.push({ label: 'noise σ ' + a, color: palette[c], dash: [5, 4], width: 1, x: at, y: tested.map((w) => positive((w.noise_sigma || f.noise_sigma)[c])) }));
+        lineChart(chartBox(row, 'fit-residual', 'Residual RMS per window against the noise σ it was tested against'), { xLabel: timeLabel, yLabel: 'm', lines, log: true });
       }
       const target = chartBox(row, 'fit-coefficients', 'Coefficient decay |c_k| in one window');
       const controls = el('div', { class: 'controls' });

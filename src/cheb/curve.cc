@@ -310,6 +310,7 @@ class WindowFitter {
     Eigen::VectorXd x(m);
     for (Eigen::Index i = 0; i < m; ++i) x[i] = window->series.interval.ToUnit(t[i]);
     const Eigen::MatrixXd residual = z - EvaluateSeries(window->series.coefficients, x);
+    window->noise_sigma = sigma;
     window->residual_rms.resize(d);
     window->lack_of_fit.resize(d);
     bool passes = true;

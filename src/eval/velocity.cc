@@ -260,8 +260,10 @@ std::string UnresolvedWarning(const cheb::Curve& curve) {
   for (const cheb::CurveSegment& segment : curve.segments()) {
     for (const cheb::CurveWindow& w : segment.windows) {
       if (w.verdict != cheb::WindowVerdict::kUnresolved || w.residual_rms.size() != curve.dimension()) continue;
+      // Against the σ the window was tested against (the noise profile's), where it has one.
+      const Eigen::VectorXd& sigma = w.noise_sigma.size() == w.residual_rms.size() ? w.noise_sigma : curve.noise_sigma();
       for (Eigen::Index c = 0; c < w.residual_rms.size(); ++c) {
-        const double ratio = curve.noise_sigma()[c] > 0.0 ? w.residual_rms[c] / curve.noise_sigma()[c] : 0.0;
+        const double ratio = sigma[c] > 0.0 ? w.residual_rms[c] / sigma[c] : 0.0;
         if (worst == nullptr || ratio > worst_ratio) worst = &w, worst_ratio = ratio;
       }
     }
@@ -294,6 +296,7 @@ std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimat
         if (w.residual_rms.size() == curve.dimension()) {  // end caps are chosen otherwise (docs/velocity.md)
           window["residual_rms_m"] = std::vector<double>(w.residual_rms.data(), w.residual_rms.data() + w.residual_rms.size());
           window["lack_of_fit"] = std::vector<double>(w.lack_of_fit.data(), w.lack_of_fit.data() + w.lack_of_fit.size());
+          window["noise_sigma_m"] = std::vector<double>(w.noise_sigma.data(), w.noise_sigma.data() + w.noise_sigma.size());
         }
         windows.push_back(std::move(window));
         degrees.insert(degrees.end(), w.degrees.begin(), w.degrees.end());

@@ -99,6 +99,11 @@ Json FitDiagnostics(const cheb::Curve& curve, const Clock& clock, std::size_t ma
         Json residual = Json::array();
         for (Eigen::Index c = 0; c < w.residual_rms.size(); ++c) residual.push_back(Rounded(w.residual_rms[c], 4));
         windows.back()["residual_rms"] = residual;
+        if (w.noise_sigma.size() == curve.dimension()) {
+          Json sigma = Json::array();
+          for (Eigen::Index c = 0; c < w.noise_sigma.size(); ++c) sigma.push_back(Rounded(w.noise_sigma[c], 4));
+          windows.back()["noise_sigma"] = sigma;
+        }
       }
       all.push_back(&w);
     }
@@ -117,10 +122,11 @@ Json FitDiagnostics(const cheb::Curve& curve, const Clock& clock, std::size_t ma
       magnitudes.push_back(column);
     }
     // White noise of σ on m samples puts the coefficients of a least-squares fit at about σ·sqrt(2/m).
+    // σ is the one the window was tested against (the noise profile's), where it has one.
+    const Eigen::VectorXd& sigma = w.noise_sigma.size() == curve.noise_sigma().size() ? w.noise_sigma : curve.noise_sigma();
     Json noise = Json::array();
-    for (Eigen::Index c = 0; c < curve.noise_sigma().size(); ++c) {
-      noise.push_back(Rounded(
-          curve.noise_sigma()[c] * std::sqrt(2.0 / static_cast<double>(std::max<Eigen::Index>(w.samples, 1))), 4));
+    for (Eigen::Index c = 0; c < sigma.size(); ++c) {
+      noise.push_back(Rounded(sigma[c] * std::sqrt(2.0 / static_cast<double>(std::max<Eigen::Index>(w.samples, 1))), 4));
     }
     coefficients.push_back({{"window", index}, {"magnitudes", magnitudes}, {"noise_level", noise}});
   }
@@ -130,6 +136,9 @@ Json FitDiagnostics(const cheb::Curve& curve, const Clock& clock, std::size_t ma
               {"windows", windows},
               {"coefficients", coefficients},
               {"noise_sigma", std::vector<double>(sigma.data(), sigma.data() + sigma.size())},
+              {"noise_sigma_max", std::vector<double>(curve.noise_sigma_max().data(),
+                                                      curve.noise_sigma_max().data() + curve.noise_sigma_max().size())},
+              {"noisier_samples", curve.noisier_samples()},
               {"residual_rms", std::vector<double>(residual.data(), residual.data() + residual.size())},
               {"unresolved_windows", curve.unresolved_windows()},
               {"local_samples", curve.local_samples()}};

@@ -146,6 +146,18 @@ TEST_F(ReportCliTest, FitDiagnosticsOfTheReference) {
   }
   // The simulator's 0.5 mm noise is what the fit estimates (within 10 %).
   for (const Json& sigma : fit["noise_sigma"]) EXPECT_NEAR(sigma.get<double>(), 0.0005, 0.00005);
+  // Each tested window carries the σ it was tested against (the noise profile's), never below the
+  // recording's; the profile's largest is reported beside it.
+  ASSERT_EQ(fit["noise_sigma_max"].size(), 3u);
+  EXPECT_TRUE(fit.contains("noisier_samples"));
+  for (const Json& w : fit["windows"]) {
+    if (!w.contains("residual_rms")) continue;
+    ASSERT_EQ(w["noise_sigma"].size(), 3u);
+    for (int axis = 0; axis < 3; ++axis) {
+      EXPECT_GE(w["noise_sigma"][axis].get<double>(), 0.999 * fit["noise_sigma"][axis].get<double>());
+      EXPECT_LE(w["noise_sigma"][axis].get<double>(), 1.001 * fit["noise_sigma_max"][axis].get<double>());
+    }
+  }
 }
 
 // One file, nothing fetched: the chart library, the page script and the data are inline, and a file

@@ -136,6 +136,9 @@ struct CurveWindow {
   /// m − N − 1 degrees of freedom for a fit that has resolved the motion; this is its standard
   /// normal score (Wilson–Hilferty), accepted up to 3 (diagnostics).
   Eigen::VectorXd lack_of_fit;
+  /// The noise σ per coordinate the residual was tested against: the noise profile's over the
+  /// window's samples (Curve::noisier_samples), floored at the values' rounding level (diagnostics).
+  Eigen::VectorXd noise_sigma;
   WindowVerdict verdict = WindowVerdict::kResolved;
   /// The window is a piece of a larger one that was split because it missed motion (its residual
   /// failed the lack-of-fit test, or its halves predicted held-out samples better).
