@@ -1097,6 +1097,26 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
               [](const LocalRun& x, const LocalRun& y) { return x.times.front() < y.times.front(); });
   }
 
+  // Where an unresolved window's rate (or the regression's) is still worse than the samples'
+  // 3-point rate (docs/velocity.md, "Local interpolant").
+  if (options.lack_of_fit && adaptive && curve.unresolved_windows() > 0) {
+    Eigen::MatrixXd curve_values, curve_rates;
+    curve.EvaluateMany(sorted, 1, &curve_values, &curve_rates);
+    for (Eigen::Index i = 0; i < fitted_count; ++i) {  // the values without the steps, as z
+      if (const Eigen::Index k = curve.StepsBefore(t[i]); k > 0) curve_values.row(i) -= curve.step_offsets_.row(k - 1);
+    }
+    std::vector<LocalRun> added;
+    for (size_t k = 0; k + 1 < starts.size(); ++k) {
+      std::vector<LocalRun> runs = internal::ThreePointRuns(t, z, starts[k], starts[k + 1], curve.segments_[k],
+                                                            local_rates[k], curve_values, curve_rates, profile,
+                                                            curve.local_runs_);
+      std::move(runs.begin(), runs.end(), std::back_inserter(added));
+    }
+    std::move(added.begin(), added.end(), std::back_inserter(curve.local_runs_));
+    std::sort(curve.local_runs_.begin(), curve.local_runs_.end(),
+              [](const LocalRun& x, const LocalRun& y) { return x.times.front() < y.times.front(); });
+  }
+
   ReportProgress(options.progress, "fitting windows", fitted_count, fitted_count);
   // Residuals at every sample fitted.
   Eigen::MatrixXd fitted;

@@ -6,10 +6,16 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <vector>
+
+#include "cheval/cheb/fit.h"
+#include "cheval/common/error.h"
 
 namespace cheval::cheb::internal {
 namespace {
+
+using Flags = Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>;
 
 // A slope departing from the mean of its two neighbours by more than this many local scales (and
 // more than they do) is an isolated spike: a small step of the values (docs/velocity.md).
@@ -22,6 +28,16 @@ constexpr double kMinHeldOut = 8;
 constexpr int kSpline = 9;
 // The variance of the interpolating cubic spline's slopes over σ²/h² for white noise at even spacing.
 constexpr double kSplineNoiseGain = 1.392;
+// w₃·w_s·h² of the 3-point rate's and the spline's slope weights at even spacing: the spline's
+// weights on the neighbours are ±(3/√12)(1 − r²), r = √3 − 2, so their covariance is
+// 0.804·σ²/h² (and the two rates differ by noise of σ²(0.5 + 1.392 − 2·0.804)/h² = 0.285·σ²/h²).
+constexpr double kThreeSplineCovariance = 0.804;
+// Windows on either side of a window pooled into the 3-point rate's gain over the curve's rate,
+// and the standard errors of the pooled mean (from the windows' scatter) it must pass by.
+constexpr Eigen::Index kPooledGainWindows = 8;
+constexpr double kGainSignificance = 2.0;
+// The most core samples over which a window's rate noise is averaged (RateNoiseGains).
+constexpr Eigen::Index kNoiseProbes = 64;
 // Windows on either side of a window pooled into its departure from the spline's slopes: the
 // smallest windows' cores hold 15–25 samples, too few for a mean square to decide by.
 constexpr Eigen::Index kPooledWindows = 2;
@@ -231,7 +247,8 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
   const Eigen::Index n = last - first, d = z.cols();
   const auto count = static_cast<Eigen::Index>(segment.windows.size());
   LocalRates rates{Eigen::ArrayXXi::Constant(count, d, 3),
-                   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(count, d, false), Eigen::MatrixXd()};
+                   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(count, d, false), Eigen::MatrixXd(),
+                   Eigen::MatrixXd()};
   // Per window: the held-out errors' sums of squares of the polynomials through 2, 3 and 4
   // neighbours on either side (degree 3, 5, 7) at the samples where all exist, their noise gains,
   // and Σ 1/h² (the 3-point rate's noise).
@@ -359,6 +376,7 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
     }
   }
   rates.spline_slopes = std::move(spline_rates);
+  rates.three_rates = std::move(three_rates);
   return rates;
 }
 
@@ -415,53 +433,78 @@ std::vector<bool> DepartsFromSpline(const Eigen::VectorXd& t, Eigen::Index first
   return departs;
 }
 
-}  // namespace
-
-std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
-                                Eigen::Index last, const CurveSegment& segment, const LocalRates& rates,
-                                const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
-                                const NoiseProfile& noise, double lack_of_fit_limit) {
-  std::vector<LocalRun> runs;
-  const Eigen::Index n = last - first, d = z.cols();
-  if (n < 3 || segment.windows.empty()) return runs;
-  // Local samples and coordinates: in the core of a window that clearly missed motion there.
-  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> local =
-      Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, false);
-  const std::vector<CurveWindow>& windows = segment.windows;
-  // Samples whose rate is the 5-point one, and the spline's (UnderResolvedRates).
-  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> five =
-      Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, false);
-  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> spline = five;
-  const std::vector<bool> departs = DepartsFromSpline(t, first, n, segment, rates, fit_rates, noise);
-  const std::vector<Eigen::Index> starts = WindowStarts(t, first, n, windows);
-  Eigen::MatrixXd window_sigma(static_cast<Eigen::Index>(windows.size()), d);
-  for (Eigen::Index k = 0; k < window_sigma.rows(); ++k) window_sigma.row(k) = NoiseOver(noise, first, starts, k, k).transpose();
-  size_t w = 0;
-  bool any = false;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const double ti = t[first + i];
-    while (w + 1 < windows.size() && ti >= windows[w + 1].core_begin) ++w;
-    const CurveWindow& window = JudgingWindow(windows, w, d);
-    if (window.lack_of_fit.size() != d) continue;
-    const bool unresolved = window.verdict == WindowVerdict::kUnresolved;
-    for (Eigen::Index c = 0; c < d; ++c) {
-      const auto k = static_cast<Eigen::Index>(w);
-      // An unresolved window that interpolates its samples (no freedom left for the residual test)
-      // shows nothing better than the samples' own interpolant, whose rate is far better conditioned.
-      const double dof = window.samples - window.degrees[static_cast<size_t>(c)] - 1.0;
-      const bool interpolates = dof <= 0.0;
-      const double variance = window.residual_rms[c] * window.residual_rms[c] * window.samples / std::max(dof, 1.0);
-      const double sigma = window_sigma(static_cast<Eigen::Index>(w), c);
-      const bool misses_motion = window.lack_of_fit[c] > lack_of_fit_limit && variance >= 2.0 * sigma * sigma;
-      local(i, c) = (unresolved && (interpolates || misses_motion || departs[static_cast<size_t>(k * d + c)])) ||
-                    rates.under_resolved(k, c);
-      five(i, c) = rates.stencil(k, c) == 5;
-      spline(i, c) = rates.stencil(k, c) == kSpline;
-      any = any || local(i, c);
+// The noise variance of a window's rate over σ², per coordinate at its degree: the mean over its
+// core's samples (at most kNoiseProbes, evenly spread) of s²·T'(x_i)ᵀG⁻¹T'(x_i), G the normal
+// matrix of its samples and s the interval's derivative scale. Zero where G is singular.
+Eigen::VectorXd RateNoiseGains(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const CurveWindow& window) {
+  const auto d = static_cast<Eigen::Index>(window.degrees.size());
+  Eigen::VectorXd gains = Eigen::VectorXd::Zero(d);
+  if (d == 0) return gains;
+  const int top = *std::max_element(window.degrees.begin(), window.degrees.end());
+  const auto at = [&](double x) { return std::lower_bound(t.data(), t.data() + t.size(), x) - t.data(); };
+  const Eigen::Index first = at(window.fit_begin);
+  const Eigen::Index last = std::upper_bound(t.data(), t.data() + t.size(), window.fit_end) - t.data();
+  const Eigen::Index core_first = at(window.core_begin), core_last = at(window.core_end);
+  if (top < 1 || core_last <= core_first || last - first <= top) return gains;
+  const Interval& interval = window.series.interval;
+  std::optional<NestedCholesky> cholesky;
+  try {
+    cholesky.emplace(BuildNormalEquations(t.segment(first, last - first), z.middleRows(first, last - first), top, interval),
+                     top);
+  } catch (const ComputeError&) {
+    return gains;
+  }
+  // T'_k(x) = k·U_{k−1}(x), by the U recurrence.
+  const Eigen::Index count = core_last - core_first, probes = std::min(count, kNoiseProbes);
+  Eigen::MatrixXd derivatives(top + 1, probes);
+  for (Eigen::Index q = 0; q < probes; ++q) {
+    const double x = interval.ToUnit(t[core_first + q * count / probes]);
+    double u_previous = 0.0, u_current = 1.0;  // U_{-1}, U_0
+    derivatives(0, q) = 0.0;
+    for (int k = 1; k <= top; ++k) {
+      derivatives(k, q) = k * u_current * interval.DerivativeScale();
+      const double next = 2.0 * x * u_current - u_previous;
+      u_previous = u_current, u_current = next;
     }
   }
-  if (!any) return runs;
+  const Eigen::MatrixXd whitened = cholesky->Whiten(top, derivatives);
+  for (Eigen::Index c = 0; c < d; ++c) {
+    const int degree = window.degrees[static_cast<size_t>(c)];
+    if (degree >= 1) gains[c] = whitened.topRows(degree + 1).colwise().squaredNorm().mean();
+  }
+  return gains;
+}
 
+// Whether the mean per sample of the gains summed per window over windows a..b (`gains`, over
+// `samples` each) exceeds `threshold` by kGainSignificance standard errors, taken from the scatter
+// of the windows' means (the spline's noise correlates neighbouring samples' gains).
+bool GainStandsOut(const Eigen::Ref<const Eigen::VectorXd>& gains, const Eigen::VectorXd& samples, Eigen::Index a,
+                   Eigen::Index b, double threshold) {
+  double sum = 0.0, total = 0.0, windows = 0.0;
+  for (Eigen::Index j = a; j <= b; ++j) {
+    if (!(samples[j] > 0.0)) continue;
+    sum += gains[j], total += samples[j], windows += 1.0;
+  }
+  if (windows < 3.0) return false;
+  const double mean = sum / total;
+  double spread = 0.0;
+  for (Eigen::Index j = a; j <= b; ++j) {
+    if (samples[j] > 0.0) spread += (gains[j] / samples[j] - mean) * (gains[j] / samples[j] - mean);
+  }
+  return mean - kGainSignificance * std::sqrt(spread / (windows - 1.0) / windows) > threshold;
+}
+
+// The local runs of a segment's samples [first, first + n): maximal stretches of samples local in
+// some coordinate (`local`, n x d), with a sample of the fit on either side, carrying the samples'
+// values and local rates (the 5-point rate where `five`, the spline's slopes where `spline`, the
+// 3-point rate otherwise) in the local coordinates and the fit's (`fit_values`, `fit_rates`, at
+// the segment's samples) in the others.
+std::vector<LocalRun> BuildRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index n,
+                                const Flags& local, const Flags& five, const Flags& spline,
+                                const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
+                                const NoiseProfile& noise) {
+  std::vector<LocalRun> runs;
+  const Eigen::Index d = z.cols();
   const Eigen::VectorXd h = t.segment(first + 1, n - 1) - t.segment(first, n - 1);
   Eigen::MatrixXd slopes = Eigen::MatrixXd::Zero(n - 1, d);
   for (Eigen::Index j = 0; j + 1 < n; ++j) {
@@ -569,6 +612,159 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
     runs.push_back(std::move(run));
   }
   return runs;
+}
+
+}  // namespace
+
+std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
+                                Eigen::Index last, const CurveSegment& segment, const LocalRates& rates,
+                                const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
+                                const NoiseProfile& noise, double lack_of_fit_limit) {
+  std::vector<LocalRun> runs;
+  const Eigen::Index n = last - first, d = z.cols();
+  if (n < 3 || segment.windows.empty()) return runs;
+  // Local samples and coordinates: in the core of a window that clearly missed motion there.
+  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> local =
+      Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, false);
+  const std::vector<CurveWindow>& windows = segment.windows;
+  // Samples whose rate is the 5-point one, and the spline's (UnderResolvedRates).
+  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> five =
+      Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, false);
+  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> spline = five;
+  const std::vector<bool> departs = DepartsFromSpline(t, first, n, segment, rates, fit_rates, noise);
+  const std::vector<Eigen::Index> starts = WindowStarts(t, first, n, windows);
+  Eigen::MatrixXd window_sigma(static_cast<Eigen::Index>(windows.size()), d);
+  for (Eigen::Index k = 0; k < window_sigma.rows(); ++k) window_sigma.row(k) = NoiseOver(noise, first, starts, k, k).transpose();
+  size_t w = 0;
+  bool any = false;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double ti = t[first + i];
+    while (w + 1 < windows.size() && ti >= windows[w + 1].core_begin) ++w;
+    const CurveWindow& window = JudgingWindow(windows, w, d);
+    if (window.lack_of_fit.size() != d) continue;
+    const bool unresolved = window.verdict == WindowVerdict::kUnresolved;
+    for (Eigen::Index c = 0; c < d; ++c) {
+      const auto k = static_cast<Eigen::Index>(w);
+      // An unresolved window that interpolates its samples (no freedom left for the residual test)
+      // shows nothing better than the samples' own interpolant, whose rate is far better conditioned.
+      const double dof = window.samples - window.degrees[static_cast<size_t>(c)] - 1.0;
+      const bool interpolates = dof <= 0.0;
+      const double variance = window.residual_rms[c] * window.residual_rms[c] * window.samples / std::max(dof, 1.0);
+      const double sigma = window_sigma(static_cast<Eigen::Index>(w), c);
+      const bool misses_motion = window.lack_of_fit[c] > lack_of_fit_limit && variance >= 2.0 * sigma * sigma;
+      local(i, c) = (unresolved && (interpolates || misses_motion || departs[static_cast<size_t>(k * d + c)])) ||
+                    rates.under_resolved(k, c);
+      five(i, c) = rates.stencil(k, c) == 5;
+      spline(i, c) = rates.stencil(k, c) == kSpline;
+      any = any || local(i, c);
+    }
+  }
+  if (!any) return runs;
+  return BuildRuns(t, z, first, n, local, five, spline, fit_values, fit_rates, noise);
+}
+
+std::vector<LocalRun> ThreePointRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
+                                     Eigen::Index last, const CurveSegment& segment, const LocalRates& rates,
+                                     const Eigen::MatrixXd& curve_values, const Eigen::MatrixXd& curve_rates,
+                                     const NoiseProfile& noise, const std::vector<LocalRun>& taken) {
+  const Eigen::Index n = last - first, d = z.cols();
+  const std::vector<CurveWindow>& windows = segment.windows;
+  const auto count = static_cast<Eigen::Index>(windows.size());
+  if (n < 3 || count == 0 || rates.spline_slopes.rows() != n || rates.three_rates.rows() != n) return {};
+  // The samples no run holds yet.
+  std::vector<char> open(static_cast<size_t>(n), 1);
+  for (const LocalRun& run : taken) {
+    const double* begin = t.data() + first;
+    const auto from = std::lower_bound(begin, begin + n, run.times.front()) - begin;
+    const auto to = std::upper_bound(begin, begin + n, run.times.back()) - begin;
+    for (auto i = from; i < to; ++i) open[static_cast<size_t>(i)] = 0;
+  }
+  // Per window, over its core's open interior samples: Σ (r_s − r)² for the curve's rate r, Σ
+  // (r_s − r₃)², the 3-point rate's gain Σ (r_s − r)² − (r_s − r₃)², their count, Σ 1/h² (h half
+  // the span of a sample's neighbours) and the shortest and longest step after them.
+  Eigen::MatrixXd departures = Eigen::MatrixXd::Zero(count, d), threes = departures, gains = departures;
+  Eigen::VectorXd samples = Eigen::VectorXd::Zero(count), inverse_h2 = samples, longest = samples;
+  Eigen::VectorXd shortest = Eigen::VectorXd::Constant(count, std::numeric_limits<double>::infinity());
+  std::vector<Eigen::Index> owner(static_cast<size_t>(n), -1);
+  Eigen::Index w = 0;
+  for (Eigen::Index i = 1; i + 1 < n; ++i) {
+    while (w + 1 < count && t[first + i] >= windows[static_cast<size_t>(w + 1)].core_begin) ++w;
+    if (!open[static_cast<size_t>(i)]) continue;
+    owner[static_cast<size_t>(i)] = w;
+    const Eigen::RowVectorXd departure = (rates.spline_slopes.row(i) - curve_rates.row(first + i)).cwiseAbs2();
+    const Eigen::RowVectorXd three = (rates.spline_slopes.row(i) - rates.three_rates.row(i)).cwiseAbs2();
+    departures.row(w) += departure;
+    threes.row(w) += three;
+    gains.row(w) += departure - three;
+    samples[w] += 1.0;
+    const double h = 0.5 * (t[first + i + 1] - t[first + i - 1]);
+    inverse_h2[w] += 1.0 / (h * h);
+    const double step = t[first + i + 1] - t[first + i];
+    shortest[w] = std::min(shortest[w], step);
+    longest[w] = std::max(longest[w], step);
+  }
+  const std::vector<Eigen::Index> starts = WindowStarts(t, first, n, windows);
+  // The curve's rate at the open samples is its window's (a blend near the core's ends), whose
+  // noise the spline's slopes share: E(r_s − r)² = b² + σ²(|w_s|² + |w|² − 2w·w_s), and w·w_s ≈ |w|²
+  // (the spline's slopes follow the window's smooth weights). So the gains of windows near an
+  // unresolved one take 2σ²|w|² per sample, the window's rate noise.
+  std::vector<char> near(static_cast<size_t>(count), 0);
+  for (Eigen::Index k = 0; k < count; ++k) {
+    if (JudgingWindow(windows, static_cast<size_t>(k), d).verdict != WindowVerdict::kUnresolved) continue;
+    for (Eigen::Index j = std::max<Eigen::Index>(0, k - kPooledGainWindows); j <= std::min(count - 1, k + kPooledGainWindows); ++j) {
+      near[static_cast<size_t>(j)] = 1;
+    }
+  }
+  for (Eigen::Index j = 0; j < count; ++j) {
+    if (!near[static_cast<size_t>(j)] || !(samples[j] > 0.0)) continue;
+    const Eigen::VectorXd rate_noise = RateNoiseGains(t, z, windows[static_cast<size_t>(j)]);
+    if (rate_noise.size() != d) continue;
+    const Eigen::VectorXd sigma = NoiseOver(noise, first, starts, j, j);
+    gains.row(j) += 2.0 * samples[j] * sigma.cwiseAbs2().cwiseProduct(rate_noise).transpose();
+  }
+  Flags local = Flags::Constant(n, d, false), spline = local;
+  bool any = false;
+  for (Eigen::Index k = 0; k < count; ++k) {
+    const CurveWindow& window = JudgingWindow(windows, static_cast<size_t>(k), d);
+    if (window.verdict != WindowVerdict::kUnresolved || window.residual_rms.size() != d || !(samples[k] > 0.0)) continue;
+    const Eigen::Index a = std::max<Eigen::Index>(0, k - kPooledGainWindows);
+    const Eigen::Index b = std::min(count - 1, k + kPooledGainWindows), pooled_count = b - a + 1;
+    const double pooled = samples.segment(a, pooled_count).sum();
+    // The constants below hold at even spacing: the steps within kOneSidedSpread of each other.
+    if (pooled < kMinHeldOut ||
+        longest.segment(a, pooled_count).maxCoeff() > kOneSidedSpread * shortest.segment(a, pooled_count).minCoeff()) {
+      continue;
+    }
+    const double mean_inverse_h2 = inverse_h2.segment(a, pooled_count).sum() / pooled;
+    const Eigen::VectorXd pooled_sigma = NoiseOver(noise, first, starts, a, b);
+    const Eigen::VectorXd sigma = NoiseOver(noise, first, starts, k, k);
+    for (Eigen::Index c = 0; c < d; ++c) {
+      if (!(window.samples > window.degrees[static_cast<size_t>(c)] + 1)) continue;
+      // With the spline's slopes as the reference of little bias, the curve's squared rate error
+      // is its mean departure d from them less σ²|w_s|² plus 2σ²·w·w_s (above), the 3-point rate's
+      // its departure d₃ plus σ²(2·w₃·w_s − |w_s|²): the 3-point rate is better where
+      // d + 2σ²·w·w_s − d₃ > 2σ²·w₃·w_s, and the spline's slopes are better still where
+      // d₃ > 2σ²(|w_s|² − w₃·w_s).
+      const double unit_noise = pooled_sigma[c] * pooled_sigma[c] * mean_inverse_h2;  // σ²/h²
+      if (!GainStandsOut(gains.col(c), samples, a, b, 2.0 * kThreeSplineCovariance * unit_noise)) continue;
+      // And the window's missed motion must be able to hold its departure (DepartsFromSpline).
+      const double departure = departures.col(c).segment(a, pooled_count).sum() / pooled;
+      const double missed = MissedMotion(window, c, sigma[c] * sigma[c]);
+      if (missed * std::numbers::pi * std::numbers::pi * mean_inverse_h2 < departure - kSplineNoiseGain * unit_noise) {
+        continue;
+      }
+      const bool splined = threes.col(c).segment(a, pooled_count).sum() / pooled >
+                           2.0 * (kSplineNoiseGain - kThreeSplineCovariance) * unit_noise;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        if (owner[static_cast<size_t>(i)] != k) continue;
+        local(i, c) = true;
+        spline(i, c) = splined;
+        any = true;
+      }
+    }
+  }
+  if (!any) return {};
+  return BuildRuns(t, z, first, n, local, Flags::Constant(n, d, false), spline, curve_values, curve_rates, noise);
 }
 
 }  // namespace cheval::cheb::internal

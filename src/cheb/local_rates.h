@@ -24,6 +24,8 @@ struct LocalRates {
   /// The slopes of the cubic spline through the segment's samples, clamped at the 3-point rates at
   /// its ends (n x d; empty where two stamps coincide).
   Eigen::MatrixXd spline_slopes;
+  /// The 3-point rates at the segment's samples (n x d; empty with the spline's slopes).
+  Eigen::MatrixXd three_rates;
 };
 
 /// The LocalRates of the windows of `segment`. Over the window's core, the held-out errors of the
@@ -83,5 +85,19 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
                                 Eigen::Index last, const CurveSegment& segment, const LocalRates& rates,
                                 const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
                                 const NoiseProfile& noise, double lack_of_fit_limit);
+
+/// Runs of the samples' 3-point rate (or the spline's slopes) in one segment, after the local runs
+/// and the local regression (`taken`, none of whose samples it takes): where, pooled over an
+/// unresolved window and kPooledGainWindows on either side of even spacing, the 3-point rate's gain
+/// over the curve's rate (`curve_values`, `curve_rates` at the segment's samples, without steps),
+/// measured against the spline's slopes as a reference of little bias, exceeds 2σ²·w₃·w_s by two
+/// standard errors of the windows' scatter, and the window's missed motion can hold the curve's
+/// departure. Where the noise dominates motion near a quarter of the rate, windows of ~20 samples
+/// miss much of it and pass their residual test with σ read high; the spline's noise makes it no
+/// better there, the 3-point rate is (docs/velocity.md, "Local interpolant").
+std::vector<LocalRun> ThreePointRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
+                                     Eigen::Index last, const CurveSegment& segment, const LocalRates& rates,
+                                     const Eigen::MatrixXd& curve_values, const Eigen::MatrixXd& curve_rates,
+                                     const NoiseProfile& noise, const std::vector<LocalRun>& taken);
 
 }  // namespace cheval::cheb::internal

@@ -45,8 +45,8 @@ inline Tones Synthesize(double rate_hz, const std::vector<Tone>& tones, double n
 
 // Per axis, 160 tones spread up to 1.5 f_max whose velocity spectrum is flat to f_max and then
 // falls as f⁻⁴ (bench/velocity_sweep.py's "broad" motion), 0.3 m/s in all, sampled at `rate_hz`
-// for 20 s without noise.
-inline Tones Broad(double rate_hz, double f_max, uint64_t seed) {
+// for 20 s with noise σ (none by default).
+inline Tones Broad(double rate_hz, double f_max, uint64_t seed, double noise = 0.0) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> gauss(1.0, 0.3);
@@ -59,7 +59,7 @@ inline Tones Broad(double rate_hz, double f_max, uint64_t seed) {
     const double amplitude = 0.3 * std::sqrt(2.0 / kTones) * shape * std::abs(gauss(rng)) / (2.0 * M_PI * hz);
     tones.push_back({j / kTones, hz, amplitude, 2.0 * M_PI * unit(rng)});
   }
-  return Synthesize(rate_hz, tones, 0.0, &rng);
+  return Synthesize(rate_hz, tones, noise, &rng);
 }
 
 }  // namespace cheval::cheb::testing_motion
