@@ -1065,16 +1065,19 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
       any_under_resolved = any_under_resolved || local_rates.back().under_resolved.any();
     }
   }
+  // The windows' fit at the samples (without the steps, as z), and per segment the local samples.
+  Eigen::MatrixXd window_values, window_rates;
+  std::vector<internal::LocalSamples> local_samples;
   if (options.lack_of_fit && adaptive && (curve.unresolved_windows() > 0 || any_under_resolved)) {
-    Eigen::MatrixXd fit_values, fit_rates;
-    curve.EvaluateMany(sorted, 1, &fit_values, &fit_rates);
-    for (Eigen::Index i = 0; i < fitted_count; ++i) {  // the fitted values without the steps, as z
-      if (const Eigen::Index k = curve.StepsBefore(t[i]); k > 0) fit_values.row(i) -= curve.step_offsets_.row(k - 1);
+    curve.EvaluateMany(sorted, 1, &window_values, &window_rates);
+    for (Eigen::Index i = 0; i < fitted_count; ++i) {
+      if (const Eigen::Index k = curve.StepsBefore(t[i]); k > 0) window_values.row(i) -= curve.step_offsets_.row(k - 1);
     }
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
-      std::vector<LocalRun> runs = internal::LocalRuns(t, z, starts[k], starts[k + 1], curve.segments_[k],
-                                                       local_rates[k], fit_values, fit_rates, profile,
-                                                       kLackOfFitLimit);
+      local_samples.push_back(internal::ChooseLocalSamples(t, starts[k], starts[k + 1], curve.segments_[k],
+                                                           local_rates[k], window_rates, profile, kLackOfFitLimit));
+      std::vector<LocalRun> runs = internal::BuildLocalRuns(t, z, starts[k], starts[k + 1], local_samples.back(),
+                                                            window_values, window_rates, profile);
       std::move(runs.begin(), runs.end(), std::back_inserter(curve.local_runs_));
     }
   }
@@ -1097,24 +1100,29 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
               [](const LocalRun& x, const LocalRun& y) { return x.times.front() < y.times.front(); });
   }
 
-  // Where an unresolved window's rate (or the regression's) is still worse than the samples'
-  // 3-point rate (docs/velocity.md, "Local interpolant").
-  if (options.lack_of_fit && adaptive && curve.unresolved_windows() > 0) {
-    Eigen::MatrixXd curve_values, curve_rates;
-    curve.EvaluateMany(sorted, 1, &curve_values, &curve_rates);
-    for (Eigen::Index i = 0; i < fitted_count; ++i) {  // the values without the steps, as z
-      if (const Eigen::Index k = curve.StepsBefore(t[i]); k > 0) curve_values.row(i) -= curve.step_offsets_.row(k - 1);
+  // Where an unresolved window's fit still gives a worse rate than the samples' 3-point rate, the
+  // samples' (docs/velocity.md, "Local interpolant"); the segment's local runs are built again.
+  if (!local_samples.empty() && curve.unresolved_windows() > 0) {
+    std::vector<LocalRun> regression;
+    for (const LocalRun& run : curve.local_runs_) {
+      if (run.regression) regression.push_back(run);
     }
-    std::vector<LocalRun> added;
+    bool added = false;
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
-      std::vector<LocalRun> runs = internal::ThreePointRuns(t, z, starts[k], starts[k + 1], curve.segments_[k],
-                                                            local_rates[k], curve_values, curve_rates, profile,
-                                                            curve.local_runs_);
-      std::move(runs.begin(), runs.end(), std::back_inserter(added));
+      added = internal::AddThreePointSamples(t, z, starts[k], starts[k + 1], curve.segments_[k], local_rates[k],
+                                             window_rates, profile, regression, &local_samples[k]) || added;
     }
-    std::move(added.begin(), added.end(), std::back_inserter(curve.local_runs_));
-    std::sort(curve.local_runs_.begin(), curve.local_runs_.end(),
-              [](const LocalRun& x, const LocalRun& y) { return x.times.front() < y.times.front(); });
+    if (added) {
+      std::vector<LocalRun> runs = std::move(regression);
+      for (size_t k = 0; k + 1 < starts.size(); ++k) {
+        std::vector<LocalRun> built = internal::BuildLocalRuns(t, z, starts[k], starts[k + 1], local_samples[k],
+                                                               window_values, window_rates, profile);
+        std::move(built.begin(), built.end(), std::back_inserter(runs));
+      }
+      std::sort(runs.begin(), runs.end(),
+                [](const LocalRun& x, const LocalRun& y) { return x.times.front() < y.times.front(); });
+      curve.local_runs_ = std::move(runs);
+    }
   }
 
   ReportProgress(options.progress, "fitting windows", fitted_count, fitted_count);

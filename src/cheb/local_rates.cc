@@ -45,7 +45,7 @@ constexpr Eigen::Index kPooledWindows = 2;
 // pass the break-even: at the break-even the expected gain is nil, and of the hundreds of windows
 // tested, those that pass only by their mean's scatter lose (tests/cheb/under_resolved_test.cc).
 constexpr double kDepartureMargin = 1.0;
-// Samples beyond the end sample in the one-sided stencil of higher order (LocalRuns), and the
+// Samples beyond the end sample in the one-sided stencil of higher order (BuildRuns), and the
 // largest ratio of its steps it is used over.
 constexpr Eigen::Index kOneSided = 5;
 constexpr double kOneSidedSpread = 1.5;
@@ -384,7 +384,7 @@ namespace {
 
 // Per window of the segment and coordinate (row-major, window · d + c): whether the window's rate
 // departs from the spline's slopes by more than the spline's noise allows, where the window's missed
-// motion could hold that departure (LocalRuns).
+// motion could hold that departure (ChooseLocalSamples).
 std::vector<bool> DepartsFromSpline(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
                                     const CurveSegment& segment, const LocalRates& rates,
                                     const Eigen::MatrixXd& fit_rates, const NoiseProfile& noise) {
@@ -409,7 +409,7 @@ std::vector<bool> DepartsFromSpline(const Eigen::VectorXd& t, Eigen::Index first
   }
   const std::vector<Eigen::Index> starts = WindowStarts(t, first, n, windows);
   for (Eigen::Index k = 0; k < count; ++k) {
-    // Only an unresolved window's samples can go to the local rate (LocalRuns).
+    // Only an unresolved window's samples can go to the local rate (ChooseLocalSamples).
     const CurveWindow& window = JudgingWindow(windows, static_cast<size_t>(k), d);
     if (window.verdict != WindowVerdict::kUnresolved || window.residual_rms.size() != d) continue;
     const Eigen::Index a = std::max<Eigen::Index>(0, k - kPooledWindows), b = std::min(count - 1, k + kPooledWindows);
@@ -616,27 +616,23 @@ std::vector<LocalRun> BuildRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
 
 }  // namespace
 
-std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
-                                Eigen::Index last, const CurveSegment& segment, const LocalRates& rates,
-                                const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
+LocalSamples ChooseLocalSamples(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index last,
+                                const CurveSegment& segment, const LocalRates& rates, const Eigen::MatrixXd& fit_rates,
                                 const NoiseProfile& noise, double lack_of_fit_limit) {
-  std::vector<LocalRun> runs;
-  const Eigen::Index n = last - first, d = z.cols();
-  if (n < 3 || segment.windows.empty()) return runs;
-  // Local samples and coordinates: in the core of a window that clearly missed motion there.
-  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> local =
-      Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, false);
+  const Eigen::Index n = last - first, d = fit_rates.cols();
+  // Local samples and coordinates: in the core of a window that clearly missed motion there; and
+  // those whose rate is the 5-point one, and the spline's (UnderResolvedRates).
+  LocalSamples chosen{Flags::Constant(n, d, false), Flags::Constant(n, d, false), Flags::Constant(n, d, false)};
+  if (n < 3 || segment.windows.empty()) return chosen;
+  Flags& local = chosen.local;
+  Flags& five = chosen.five;
+  Flags& spline = chosen.spline;
   const std::vector<CurveWindow>& windows = segment.windows;
-  // Samples whose rate is the 5-point one, and the spline's (UnderResolvedRates).
-  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> five =
-      Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(n, d, false);
-  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> spline = five;
   const std::vector<bool> departs = DepartsFromSpline(t, first, n, segment, rates, fit_rates, noise);
   const std::vector<Eigen::Index> starts = WindowStarts(t, first, n, windows);
   Eigen::MatrixXd window_sigma(static_cast<Eigen::Index>(windows.size()), d);
   for (Eigen::Index k = 0; k < window_sigma.rows(); ++k) window_sigma.row(k) = NoiseOver(noise, first, starts, k, k).transpose();
   size_t w = 0;
-  bool any = false;
   for (Eigen::Index i = 0; i < n; ++i) {
     const double ti = t[first + i];
     while (w + 1 < windows.size() && ti >= windows[w + 1].core_begin) ++w;
@@ -656,58 +652,67 @@ std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
                     rates.under_resolved(k, c);
       five(i, c) = rates.stencil(k, c) == 5;
       spline(i, c) = rates.stencil(k, c) == kSpline;
-      any = any || local(i, c);
     }
   }
-  if (!any) return runs;
-  return BuildRuns(t, z, first, n, local, five, spline, fit_values, fit_rates, noise);
+  return chosen;
 }
 
-std::vector<LocalRun> ThreePointRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
-                                     Eigen::Index last, const CurveSegment& segment, const LocalRates& rates,
-                                     const Eigen::MatrixXd& curve_values, const Eigen::MatrixXd& curve_rates,
-                                     const NoiseProfile& noise, const std::vector<LocalRun>& taken) {
+std::vector<LocalRun> BuildLocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
+                                     Eigen::Index last, const LocalSamples& chosen, const Eigen::MatrixXd& fit_values,
+                                     const Eigen::MatrixXd& fit_rates, const NoiseProfile& noise) {
+  if (last - first < 3 || !chosen.local.any()) return {};
+  return BuildRuns(t, z, first, last - first, chosen.local, chosen.five, chosen.spline, fit_values, fit_rates, noise);
+}
+
+bool AddThreePointSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index last,
+                          const CurveSegment& segment, const LocalRates& rates, const Eigen::MatrixXd& fit_rates,
+                          const NoiseProfile& noise, const std::vector<LocalRun>& regression, LocalSamples* chosen) {
   const Eigen::Index n = last - first, d = z.cols();
   const std::vector<CurveWindow>& windows = segment.windows;
   const auto count = static_cast<Eigen::Index>(windows.size());
-  if (n < 3 || count == 0 || rates.spline_slopes.rows() != n || rates.three_rates.rows() != n) return {};
-  // The samples no run holds yet.
-  std::vector<char> open(static_cast<size_t>(n), 1);
-  for (const LocalRun& run : taken) {
+  if (n < 3 || count == 0 || rates.spline_slopes.rows() != n || rates.three_rates.rows() != n) return false;
+  // The samples and coordinates whose rate is the windows' fit: not local, and in no run of the
+  // local regression.
+  Flags open = !chosen->local;
+  for (const LocalRun& run : regression) {
     const double* begin = t.data() + first;
     const auto from = std::lower_bound(begin, begin + n, run.times.front()) - begin;
     const auto to = std::upper_bound(begin, begin + n, run.times.back()) - begin;
-    for (auto i = from; i < to; ++i) open[static_cast<size_t>(i)] = 0;
+    if (to > from) open.middleRows(from, to - from).setConstant(false);
   }
-  // Per window, over its core's open interior samples: Σ (r_s − r)² for the curve's rate r, Σ
-  // (r_s − r₃)², the 3-point rate's gain Σ (r_s − r)² − (r_s − r₃)², their count, Σ 1/h² (h half
-  // the span of a sample's neighbours) and the shortest and longest step after them.
+  // Per window, over its core's interior samples: per coordinate over the open ones, Σ (r_s − r)²
+  // for the fit's rate r, Σ (r_s − r₃)², the 3-point rate's gain Σ (r_s − r)² − (r_s − r₃)² and
+  // their count; over all, their count, Σ 1/h² (h half the span of a sample's neighbours) and the
+  // shortest and longest step after them.
   Eigen::MatrixXd departures = Eigen::MatrixXd::Zero(count, d), threes = departures, gains = departures;
+  Eigen::MatrixXd counted = departures;
   Eigen::VectorXd samples = Eigen::VectorXd::Zero(count), inverse_h2 = samples, longest = samples;
   Eigen::VectorXd shortest = Eigen::VectorXd::Constant(count, std::numeric_limits<double>::infinity());
   std::vector<Eigen::Index> owner(static_cast<size_t>(n), -1);
   Eigen::Index w = 0;
   for (Eigen::Index i = 1; i + 1 < n; ++i) {
     while (w + 1 < count && t[first + i] >= windows[static_cast<size_t>(w + 1)].core_begin) ++w;
-    if (!open[static_cast<size_t>(i)]) continue;
     owner[static_cast<size_t>(i)] = w;
-    const Eigen::RowVectorXd departure = (rates.spline_slopes.row(i) - curve_rates.row(first + i)).cwiseAbs2();
-    const Eigen::RowVectorXd three = (rates.spline_slopes.row(i) - rates.three_rates.row(i)).cwiseAbs2();
-    departures.row(w) += departure;
-    threes.row(w) += three;
-    gains.row(w) += departure - three;
     samples[w] += 1.0;
     const double h = 0.5 * (t[first + i + 1] - t[first + i - 1]);
     inverse_h2[w] += 1.0 / (h * h);
     const double step = t[first + i + 1] - t[first + i];
     shortest[w] = std::min(shortest[w], step);
     longest[w] = std::max(longest[w], step);
+    for (Eigen::Index c = 0; c < d; ++c) {
+      if (!open(i, c)) continue;
+      const double departure = std::pow(rates.spline_slopes(i, c) - fit_rates(first + i, c), 2);
+      const double three = std::pow(rates.spline_slopes(i, c) - rates.three_rates(i, c), 2);
+      departures(w, c) += departure;
+      threes(w, c) += three;
+      gains(w, c) += departure - three;
+      counted(w, c) += 1.0;
+    }
   }
   const std::vector<Eigen::Index> starts = WindowStarts(t, first, n, windows);
-  // The curve's rate at the open samples is its window's (a blend near the core's ends), whose
-  // noise the spline's slopes share: E(r_s − r)² = b² + σ²(|w_s|² + |w|² − 2w·w_s), and w·w_s ≈ |w|²
-  // (the spline's slopes follow the window's smooth weights). So the gains of windows near an
-  // unresolved one take 2σ²|w|² per sample, the window's rate noise.
+  // The fit's rate noise, which the spline's slopes share: E(r_s − r)² = b² + σ²(|w_s|² + |w|² −
+  // 2w·w_s), and w·w_s ≈ |w|² (the spline's slopes follow the window's smooth weights). So the
+  // gains of windows near an unresolved one take 2σ²|w|² per sample, its rate noise (RateNoiseGains).
   std::vector<char> near(static_cast<size_t>(count), 0);
   for (Eigen::Index k = 0; k < count; ++k) {
     if (JudgingWindow(windows, static_cast<size_t>(k), d).verdict != WindowVerdict::kUnresolved) continue;
@@ -716,17 +721,16 @@ std::vector<LocalRun> ThreePointRuns(const Eigen::VectorXd& t, const Eigen::Matr
     }
   }
   for (Eigen::Index j = 0; j < count; ++j) {
-    if (!near[static_cast<size_t>(j)] || !(samples[j] > 0.0)) continue;
+    if (!near[static_cast<size_t>(j)] || !(counted.row(j).array() > 0.0).any()) continue;
     const Eigen::VectorXd rate_noise = RateNoiseGains(t, z, windows[static_cast<size_t>(j)]);
     if (rate_noise.size() != d) continue;
     const Eigen::VectorXd sigma = NoiseOver(noise, first, starts, j, j);
-    gains.row(j) += 2.0 * samples[j] * sigma.cwiseAbs2().cwiseProduct(rate_noise).transpose();
+    gains.row(j) += 2.0 * counted.row(j).cwiseProduct(sigma.cwiseAbs2().cwiseProduct(rate_noise).transpose());
   }
-  Flags local = Flags::Constant(n, d, false), spline = local;
-  bool any = false;
+  bool added = false;
   for (Eigen::Index k = 0; k < count; ++k) {
     const CurveWindow& window = JudgingWindow(windows, static_cast<size_t>(k), d);
-    if (window.verdict != WindowVerdict::kUnresolved || window.residual_rms.size() != d || !(samples[k] > 0.0)) continue;
+    if (window.verdict != WindowVerdict::kUnresolved || window.residual_rms.size() != d) continue;
     const Eigen::Index a = std::max<Eigen::Index>(0, k - kPooledGainWindows);
     const Eigen::Index b = std::min(count - 1, k + kPooledGainWindows), pooled_count = b - a + 1;
     const double pooled = samples.segment(a, pooled_count).sum();
@@ -739,32 +743,34 @@ std::vector<LocalRun> ThreePointRuns(const Eigen::VectorXd& t, const Eigen::Matr
     const Eigen::VectorXd pooled_sigma = NoiseOver(noise, first, starts, a, b);
     const Eigen::VectorXd sigma = NoiseOver(noise, first, starts, k, k);
     for (Eigen::Index c = 0; c < d; ++c) {
+      const double open_pooled = counted.col(c).segment(a, pooled_count).sum();
+      if (!(counted(k, c) > 0.0) || open_pooled < kMinHeldOut) continue;
       if (!(window.samples > window.degrees[static_cast<size_t>(c)] + 1)) continue;
-      // With the spline's slopes as the reference of little bias, the curve's squared rate error
+      // With the spline's slopes as the reference of little bias, the fit's squared rate error
       // is its mean departure d from them less σ²|w_s|² plus 2σ²·w·w_s (above), the 3-point rate's
       // its departure d₃ plus σ²(2·w₃·w_s − |w_s|²): the 3-point rate is better where
       // d + 2σ²·w·w_s − d₃ > 2σ²·w₃·w_s, and the spline's slopes are better still where
       // d₃ > 2σ²(|w_s|² − w₃·w_s).
       const double unit_noise = pooled_sigma[c] * pooled_sigma[c] * mean_inverse_h2;  // σ²/h²
-      if (!GainStandsOut(gains.col(c), samples, a, b, 2.0 * kThreeSplineCovariance * unit_noise)) continue;
+      if (!GainStandsOut(gains.col(c), counted.col(c), a, b, 2.0 * kThreeSplineCovariance * unit_noise)) continue;
       // And the window's missed motion must be able to hold its departure (DepartsFromSpline).
-      const double departure = departures.col(c).segment(a, pooled_count).sum() / pooled;
+      const double departure = departures.col(c).segment(a, pooled_count).sum() / open_pooled;
       const double missed = MissedMotion(window, c, sigma[c] * sigma[c]);
       if (missed * std::numbers::pi * std::numbers::pi * mean_inverse_h2 < departure - kSplineNoiseGain * unit_noise) {
         continue;
       }
-      const bool splined = threes.col(c).segment(a, pooled_count).sum() / pooled >
+      const bool splined = threes.col(c).segment(a, pooled_count).sum() / open_pooled >
                            2.0 * (kSplineNoiseGain - kThreeSplineCovariance) * unit_noise;
       for (Eigen::Index i = 0; i < n; ++i) {
-        if (owner[static_cast<size_t>(i)] != k) continue;
-        local(i, c) = true;
-        spline(i, c) = splined;
-        any = true;
+        if (owner[static_cast<size_t>(i)] != k || !open(i, c)) continue;
+        chosen->local(i, c) = true;
+        chosen->five(i, c) = false;
+        chosen->spline(i, c) = splined;
+        added = true;
       }
     }
   }
-  if (!any) return {};
-  return BuildRuns(t, z, first, n, local, Flags::Constant(n, d, false), spline, curve_values, curve_rates, noise);
+  return added;
 }
 
 }  // namespace cheval::cheb::internal

@@ -43,7 +43,14 @@ struct LocalRates {
 LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                               Eigen::Index last, const CurveSegment& segment, const NoiseProfile& noise);
 
-/// The local runs of one segment. A sample is local in coordinate c when it lies in the core of
+/// Per sample of a segment (rows) and coordinate (columns): whether the curve follows the sample
+/// there (`local`), and whether its rate is then the 5-point one (`five`) or the spline's slopes
+/// (`spline`) instead of the 3-point one.
+struct LocalSamples {
+  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> local, five, spline;
+};
+
+/// The local samples of one segment. A sample is local in coordinate c when it lies in the core of
 /// a window accepted unresolved
 /// - whose residual in c is clearly above the noise: the lack-of-fit score above its limit and the
 ///   residual's variance on its degrees of freedom, RSS/(m − N − 1), at least 2σ² (the missed
@@ -60,11 +67,19 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
 ///   lies mostly below the noise in each window's residual; in its rate it is clear;
 /// - or of a window whose samples under-resolve the motion (`rates`).
 ///
-/// A run is a maximal stretch of consecutive samples local in some coordinate,
-/// with one sample of the fit on either side inside the segment (its value and derivative are the
-/// fit's: the curve stays C¹ where it passes from the fit to the samples).
+/// `t` (sorted, s) is the curve's fitted samples' stamps, [first, last) the segment's, `rates` its
+/// UnderResolvedRates, `fit_rates` (m x d) the segment's fit at them, `noise` the curve's noise
+/// profile (σ per window: its RMS over the window's core).
+LocalSamples ChooseLocalSamples(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index last,
+                                const CurveSegment& segment, const LocalRates& rates, const Eigen::MatrixXd& fit_rates,
+                                const NoiseProfile& noise, double lack_of_fit_limit);
+
+/// The local runs of one segment's `chosen` samples. A run is a maximal stretch of consecutive
+/// samples local in some coordinate, with one sample of the fit on either side inside the segment
+/// (its value and derivative are the fit's: the curve stays C¹ where it passes from the fit to
+/// the samples).
 ///
-/// The rate at a local sample is its window's stencil in `rates`: the derivative of the quadratic
+/// The rate at a local sample is the stencil chosen for it: the derivative of the quadratic
 /// through it and its two neighbours (one-sided at the segment's ends), of the quartic through it
 /// and two neighbours on either side, or the clamped cubic spline's slopes over stretches, from
 /// slopes between consecutive samples that are neither over a close step (shorter than half the
@@ -78,26 +93,24 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
 /// truth) and is not used.
 ///
 /// `t` (sorted, s) and `z` (m x d, steps taken out) are the curve's fitted samples, [first, last)
-/// the segment's, `rates` its UnderResolvedRates, `fit_values` and `fit_rates` (m x d)
-/// the segment's fit at them, `noise` the curve's noise profile (σ per window: its RMS over the
-/// window's core).
-std::vector<LocalRun> LocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
-                                Eigen::Index last, const CurveSegment& segment, const LocalRates& rates,
-                                const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
-                                const NoiseProfile& noise, double lack_of_fit_limit);
+/// the segment's, `fit_values` and `fit_rates` (m x d) the segment's fit at them, `noise` the
+/// curve's noise profile.
+std::vector<LocalRun> BuildLocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
+                                     Eigen::Index last, const LocalSamples& chosen, const Eigen::MatrixXd& fit_values,
+                                     const Eigen::MatrixXd& fit_rates, const NoiseProfile& noise);
 
-/// Runs of the samples' 3-point rate (or the spline's slopes) in one segment, after the local runs
-/// and the local regression (`taken`, none of whose samples it takes): where, pooled over an
-/// unresolved window and kPooledGainWindows on either side of even spacing, the 3-point rate's gain
-/// over the curve's rate (`curve_values`, `curve_rates` at the segment's samples, without steps),
-/// measured against the spline's slopes as a reference of little bias, exceeds 2σ²·w₃·w_s by two
-/// standard errors of the windows' scatter, and the window's missed motion can hold the curve's
-/// departure. Where the noise dominates motion near a quarter of the rate, windows of ~20 samples
-/// miss much of it and pass their residual test with σ read high; the spline's noise makes it no
-/// better there, the 3-point rate is (docs/velocity.md, "Local interpolant").
-std::vector<LocalRun> ThreePointRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
-                                     Eigen::Index last, const CurveSegment& segment, const LocalRates& rates,
-                                     const Eigen::MatrixXd& curve_values, const Eigen::MatrixXd& curve_rates,
-                                     const NoiseProfile& noise, const std::vector<LocalRun>& taken);
+/// Adds to a segment's `chosen` local samples, after the local regression (`regression`: its runs,
+/// whose samples it leaves), the samples and coordinates whose rate is the windows' fit where,
+/// pooled over an unresolved window and kPooledGainWindows on either side of even spacing, the
+/// 3-point rate's gain over the fit's rate (`fit_rates`), measured against the spline's slopes as a
+/// reference of little bias with the fit's rate noise counted, exceeds 2σ²·w₃·w_s by two standard
+/// errors of the windows' scatter, and the window's missed motion can hold the fit's departure.
+/// Their rate is the 3-point one, or the spline's slopes where those are better still. Where the
+/// noise dominates motion near a quarter of the rate, windows of ~20 samples miss much of it and
+/// pass their residual test with σ read high, and the spline's noise makes it no better; the
+/// 3-point rate is (docs/velocity.md, "Local interpolant"). Returns whether any sample was added.
+bool AddThreePointSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index last,
+                          const CurveSegment& segment, const LocalRates& rates, const Eigen::MatrixXd& fit_rates,
+                          const NoiseProfile& noise, const std::vector<LocalRun>& regression, LocalSamples* chosen);
 
 }  // namespace cheval::cheb::internal
