@@ -104,16 +104,31 @@ bool Close(const Eigen::VectorXd& h, Eigen::Index j) {
   return std::isfinite(beside) && h[j] > 0.0 && h[j] < kCloseStep * beside;
 }
 
-// The first of the segment's n samples (from `first`) in each window's core, and n after the
-// last: a sample is the last window's whose core begins at or before it.
-std::vector<Eigen::Index> WindowStarts(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
-                                       const std::vector<CurveWindow>& windows) {
-  std::vector<Eigen::Index> starts(windows.size() + 1, n);
-  starts[0] = 0;
-  Eigen::Index i = 0;
-  for (size_t w = 1; w < windows.size(); ++w) {
-    while (i < n && t[first + i] < windows[w].core_begin) ++i;
-    starts[w] = i;
+}  // namespace
+
+std::vector<Eigen::Index> SampleWindows(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
+                                        const std::vector<CurveWindow>& windows) {
+  std::vector<Eigen::Index> owner(static_cast<size_t>(n), 0);
+  const auto count = static_cast<Eigen::Index>(windows.size());
+  Eigen::Index w = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    while (w + 1 < count && t[first + i] >= windows[static_cast<size_t>(w + 1)].core_begin) ++w;
+    owner[static_cast<size_t>(i)] = w;
+  }
+  return owner;
+}
+
+namespace {
+
+// The first of the segment's samples in each of `count` windows' cores, and the sample count after
+// the last, from the samples' windows (SampleWindows); a window without samples starts where the
+// next does.
+std::vector<Eigen::Index> WindowStarts(const std::vector<Eigen::Index>& owner, Eigen::Index count) {
+  const auto n = static_cast<Eigen::Index>(owner.size());
+  std::vector<Eigen::Index> starts(static_cast<size_t>(count + 1), n);
+  for (Eigen::Index i = n - 1; i >= 0; --i) starts[static_cast<size_t>(owner[static_cast<size_t>(i)])] = i;
+  for (Eigen::Index w = count - 1; w >= 0; --w) {
+    starts[static_cast<size_t>(w)] = std::min(starts[static_cast<size_t>(w)], starts[static_cast<size_t>(w + 1)]);
   }
   return starts;
 }
@@ -143,6 +158,11 @@ Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> UsableSlopes(const Eigen::Vec
       departure.row(j) = slopes.row(j) - 0.5 * (slopes.row(j - 1) + slopes.row(j + 1));
     }
   }
+  // The noise's floor of the local scale per slope, sqrt(5)·σ/h (σ over the slope's two samples).
+  Eigen::MatrixXd floors = Eigen::MatrixXd::Zero(n, d);
+  for (Eigen::Index j = 1; j + 1 < n; ++j) {
+    if (h[j] > 0.0) floors.row(j) = std::sqrt(5.0) * noise.Over(first + j, 2).transpose() / h[j];
+  }
   std::vector<double> block;
   for (Eigen::Index c = 0; c < d; ++c) {
     Eigen::VectorXd score = Eigen::VectorXd::Zero(n);
@@ -155,8 +175,7 @@ Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> UsableSlopes(const Eigen::Vec
       const double scale = 1.4826 * *middle;
       for (Eigen::Index j = begin; j < end; ++j) {
         if (!(h[j] > 0.0)) continue;
-        const double floor = std::sqrt(5.0) * noise.Over(first + j, 2)[c] / h[j];
-        const double s = std::max(scale, floor);
+        const double s = std::max(scale, floors(j, c));
         score[j] = s > 0.0 ? std::abs(departure(j, c)) / s : 0.0;
       }
     }
@@ -288,9 +307,9 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
       SplineSlopes(times, values, 1, n - 2, spline_rates.col(c));
     }
   }
-  Eigen::Index w = 0;
+  const std::vector<Eigen::Index> owner = SampleWindows(t, first, n, segment.windows);
   for (Eigen::Index i = 0; i < n; ++i) {
-    while (w + 1 < count && t[first + i] >= segment.windows[static_cast<size_t>(w + 1)].core_begin) ++w;
+    const Eigen::Index w = owner[static_cast<size_t>(i)];
     if (distinct) {
       departures.row(w) += (three_rates.row(i) - spline_rates.row(i)).cwiseAbs2();
       counted[w] += 1.0;
@@ -320,7 +339,7 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
     const double h = 0.5 * (t[first + i + 1] - t[first + i - 1]);
     spacing[w] += 1.0 / (h * h);
   }
-  const std::vector<Eigen::Index> starts = WindowStarts(t, first, n, segment.windows);
+  const std::vector<Eigen::Index> starts = WindowStarts(owner, count);
   for (Eigen::Index k = 0; k < count; ++k) {
     const CurveWindow& window = segment.windows[static_cast<size_t>(k)];
     if (used[k] < kMinHeldOut || window.residual_rms.size() != d || window.degrees.size() != static_cast<size_t>(d)) {
@@ -341,25 +360,25 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
       const bool falls = quintic < kUnderResolved * cubic && septic < kUnderResolved * quintic;
       const double u = std::min(4.0, quintic / cubic / 0.09), omega_h = 2.0 * std::asin(0.5 * std::sqrt(u));
       // The degree-7 error less what the motion gives it bounds the noise.
-      const double frequency = omega_h / h, noise = std::max(0.0, septic - 0.0816 * u * quintic) / gains(k, 2);
+      const double frequency = omega_h / h, noise_variance = std::max(0.0, septic - 0.0816 * u * quintic) / gains(k, 2);
       // What the window missed (MissedMotion, with that noise): above the 2N/span it resolves, the
       // missed motion's rate errs by that times the frequency.
       const bool above = frequency > 2.0 * (p - 1.0) / span;
-      const double missed = MissedMotion(window, c, noise);
+      const double missed = MissedMotion(window, c, noise_variance);
       // Each local rate's error: its noise σ²·Σw² and its bias at ω, a fraction of the motion's
       // rate, the motion being 6/u² of the cubic's error. The 3-point rate (central difference):
       // Σw² = 1/(2h²), fraction 1 − sin(ωh)/ωh; the 5-point one (the quartic's derivative):
       // Σw² = 130/(144h²), fraction 1 − (8 sin(ωh) − sin(2ωh))/(6ωh).
-      const double motion = std::max(0.0, cubic - noise * gains(k, 0)) / used[k];
+      const double motion = std::max(0.0, cubic - noise_variance * gains(k, 0)) / used[k];
       const double scale = 6.0 / (u * u) * frequency, inverse_h2 = spacing[k] / used[k];
       const double bias3 = scale * (1.0 - std::sin(omega_h) / omega_h);
       const double bias5 = scale * (1.0 - (8.0 * std::sin(omega_h) - std::sin(2.0 * omega_h)) / (6.0 * omega_h));
       // The interpolating cubic spline's slopes (C² at the samples): Σw² = 1.392/h², fraction
       // 1 − 3 sin(ωh)/(ωh(2 + cos ωh)).
       const double bias_spline = scale * (1.0 - 3.0 * std::sin(omega_h) / (omega_h * (2.0 + std::cos(omega_h))));
-      const double error3 = noise * 0.5 * inverse_h2 + motion * bias3 * bias3;
-      const double error5 = noise * 130.0 / 144.0 * inverse_h2 + motion * bias5 * bias5;
-      const double error_spline = noise * 1.392 * inverse_h2 + motion * bias_spline * bias_spline;
+      const double error3 = noise_variance * 0.5 * inverse_h2 + motion * bias3 * bias3;
+      const double error5 = noise_variance * 130.0 / 144.0 * inverse_h2 + motion * bias5 * bias5;
+      const double error_spline = noise_variance * 1.392 * inverse_h2 + motion * bias_spline * bias_spline;
       const double best = std::min({error3, error5, error_spline});
       rates.stencil(k, c) = best == error_spline ? kSpline : best == error5 ? 5 : 3;
       // Where the model prefers the 3-point rate, the samples may still say otherwise: its bias
@@ -397,9 +416,9 @@ std::vector<bool> DepartsFromSpline(const Eigen::VectorXd& t, Eigen::Index first
   // the span of a sample's neighbours).
   Eigen::MatrixXd squares = Eigen::MatrixXd::Zero(count, d), fourth = squares;
   Eigen::VectorXd samples = Eigen::VectorXd::Zero(count), inverse_h2 = Eigen::VectorXd::Zero(count);
-  Eigen::Index w = 0;
+  const std::vector<Eigen::Index> owner = SampleWindows(t, first, n, windows);
   for (Eigen::Index i = 1; i + 1 < n; ++i) {
-    while (w + 1 < count && t[first + i] >= windows[static_cast<size_t>(w + 1)].core_begin) ++w;
+    const Eigen::Index w = owner[static_cast<size_t>(i)];
     const double h = 0.5 * (t[first + i + 1] - t[first + i - 1]);
     const Eigen::RowVectorXd sq = (rates.spline_slopes.row(i) - fit_rates.row(first + i)).cwiseAbs2();
     squares.row(w) += sq;
@@ -407,7 +426,7 @@ std::vector<bool> DepartsFromSpline(const Eigen::VectorXd& t, Eigen::Index first
     samples[w] += 1.0;
     inverse_h2[w] += 1.0 / (h * h);
   }
-  const std::vector<Eigen::Index> starts = WindowStarts(t, first, n, windows);
+  const std::vector<Eigen::Index> starts = WindowStarts(owner, count);
   for (Eigen::Index k = 0; k < count; ++k) {
     // Only an unresolved window's samples can go to the local rate (ChooseLocalSamples).
     const CurveWindow& window = JudgingWindow(windows, static_cast<size_t>(k), d);
@@ -629,13 +648,12 @@ LocalSamples ChooseLocalSamples(const Eigen::VectorXd& t, Eigen::Index first, Ei
   Flags& spline = chosen.spline;
   const std::vector<CurveWindow>& windows = segment.windows;
   const std::vector<bool> departs = DepartsFromSpline(t, first, n, segment, rates, fit_rates, noise);
-  const std::vector<Eigen::Index> starts = WindowStarts(t, first, n, windows);
+  const std::vector<Eigen::Index> owner = SampleWindows(t, first, n, windows);
+  const std::vector<Eigen::Index> starts = WindowStarts(owner, static_cast<Eigen::Index>(windows.size()));
   Eigen::MatrixXd window_sigma(static_cast<Eigen::Index>(windows.size()), d);
   for (Eigen::Index k = 0; k < window_sigma.rows(); ++k) window_sigma.row(k) = NoiseOver(noise, first, starts, k, k).transpose();
-  size_t w = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
-    const double ti = t[first + i];
-    while (w + 1 < windows.size() && ti >= windows[w + 1].core_begin) ++w;
+    const auto w = static_cast<size_t>(owner[static_cast<size_t>(i)]);
     const CurveWindow& window = JudgingWindow(windows, w, d);
     if (window.lack_of_fit.size() != d) continue;
     const bool unresolved = window.verdict == WindowVerdict::kUnresolved;
@@ -688,11 +706,9 @@ bool AddThreePointSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Ei
   Eigen::MatrixXd counted = departures;
   Eigen::VectorXd samples = Eigen::VectorXd::Zero(count), inverse_h2 = samples, longest = samples;
   Eigen::VectorXd shortest = Eigen::VectorXd::Constant(count, std::numeric_limits<double>::infinity());
-  std::vector<Eigen::Index> owner(static_cast<size_t>(n), -1);
-  Eigen::Index w = 0;
+  const std::vector<Eigen::Index> owner = SampleWindows(t, first, n, windows);
   for (Eigen::Index i = 1; i + 1 < n; ++i) {
-    while (w + 1 < count && t[first + i] >= windows[static_cast<size_t>(w + 1)].core_begin) ++w;
-    owner[static_cast<size_t>(i)] = w;
+    const Eigen::Index w = owner[static_cast<size_t>(i)];
     samples[w] += 1.0;
     const double h = 0.5 * (t[first + i + 1] - t[first + i - 1]);
     inverse_h2[w] += 1.0 / (h * h);
@@ -709,7 +725,7 @@ bool AddThreePointSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Ei
       counted(w, c) += 1.0;
     }
   }
-  const std::vector<Eigen::Index> starts = WindowStarts(t, first, n, windows);
+  const std::vector<Eigen::Index> starts = WindowStarts(owner, count);
   // The fit's rate noise, which the spline's slopes share: E(r_s − r)² = b² + σ²(|w_s|² + |w|² −
   // 2w·w_s), and w·w_s ≈ |w|² (the spline's slopes follow the window's smooth weights). So the
   // gains of windows near an unresolved one take 2σ²|w|² per sample, its rate noise (RateNoiseGains).
@@ -761,8 +777,9 @@ bool AddThreePointSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Ei
       }
       const bool splined = threes.col(c).segment(a, pooled_count).sum() / open_pooled >
                            2.0 * (kSplineNoiseGain - kThreeSplineCovariance) * unit_noise;
-      for (Eigen::Index i = 0; i < n; ++i) {
-        if (owner[static_cast<size_t>(i)] != k || !open(i, c)) continue;
+      for (Eigen::Index i = std::max<Eigen::Index>(1, starts[static_cast<size_t>(k)]);
+           i < std::min(n - 1, starts[static_cast<size_t>(k + 1)]); ++i) {
+        if (!open(i, c)) continue;
         chosen->local(i, c) = true;
         chosen->five(i, c) = false;
         chosen->spline(i, c) = splined;

@@ -12,6 +12,11 @@ namespace cheval::cheb::internal {
 
 class NoiseProfile;
 
+/// The window of each of a segment's n samples (from `first` in the sorted stamps `t`, s): the
+/// last window whose core begins at or before the sample, the first window before that.
+std::vector<Eigen::Index> SampleWindows(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
+                                        const std::vector<CurveWindow>& windows);
+
 /// Per window of a segment (rows) and coordinate (columns): the samples' local rate, 3 (the
 /// derivative of the quadratic through a sample and its neighbours), 5 (of the quartic through it
 /// and two neighbours on either side) or 9 (the slopes of the cubic spline through the samples),

@@ -1,5 +1,6 @@
 #include "local_regression.h"
 
+#include "local_rates.h"
 #include "noise_profile.h"
 
 #include <algorithm>
@@ -343,21 +344,21 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
   const std::vector<CurveWindow>& windows = segment.windows;
   const Eigen::Index n = last - first, d = z.cols();
   if (windows.size() < 3 || n < 2 * kHalves.back() + 1) return runs;
-  // Candidate samples and the window whose core holds each.
+  // Candidate samples and the window whose core holds each: not in a segment's first or last
+  // window, nor inside a run taken already.
   std::vector<int> owner(static_cast<size_t>(n), -1);
-  bool any = false;
-  size_t w = 0;
+  const std::vector<Eigen::Index> windows_of = SampleWindows(t, first, n, windows);
   for (Eigen::Index i = 0; i < n; ++i) {
-    const double ti = t[first + i];
-    while (w + 1 < windows.size() && ti >= windows[w + 1].core_begin) ++w;
-    if (w == 0 || w + 1 == windows.size() || !RegressionMayGain(windows[w])) continue;
-    const bool inside = std::any_of(taken.begin(), taken.end(), [ti](const LocalRun& run) {
-      return ti >= run.times.front() && ti <= run.times.back();
-    });
-    if (inside) continue;
-    owner[static_cast<size_t>(i)] = static_cast<int>(w);
-    any = true;
+    const auto w = static_cast<size_t>(windows_of[static_cast<size_t>(i)]);
+    if (w > 0 && w + 1 < windows.size() && RegressionMayGain(windows[w])) owner[static_cast<size_t>(i)] = static_cast<int>(w);
   }
+  for (const LocalRun& run : taken) {
+    const double* begin = t.data() + first;
+    const auto from = std::lower_bound(begin, begin + n, run.times.front()) - begin;
+    const auto to = std::upper_bound(begin, begin + n, run.times.back()) - begin;
+    for (auto i = from; i < to; ++i) owner[static_cast<size_t>(i)] = -1;
+  }
+  const bool any = std::any_of(owner.begin(), owner.end(), [](int w) { return w >= 0; });
   if (!any) return runs;
 
   const auto ts = t.segment(first, n);

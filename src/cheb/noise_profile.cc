@@ -27,7 +27,7 @@ NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitu
     Eigen::RowVectorXd variance = level.cwiseAbs2().transpose();
     bool raised = false;
     for (Eigen::Index c = 0; c < d; ++c) {
-      if (local[c] > kRaise * level[c]) {
+      if (local[c] > raise[c]) {
         variance[c] = local[c] * local[c];
         maximum_[c] = std::max(maximum_[c], local[c]);
         raised = true;
