@@ -1109,7 +1109,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     }
     bool added = false;
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
-      added = internal::AddThreePointSamples(t, z, starts[k], starts[k + 1], curve.segments_[k], local_rates[k],
+      added = internal::ReviseLocalSamples(t, z, starts[k], starts[k + 1], curve.segments_[k], local_rates[k],
                                              window_rates, profile, regression, &local_samples[k]) || added;
     }
     if (added) {

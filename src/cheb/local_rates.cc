@@ -3,6 +3,7 @@
 #include "noise_profile.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -28,10 +29,17 @@ constexpr double kMinHeldOut = 8;
 constexpr int kSpline = 9;
 // The variance of the interpolating cubic spline's slopes over σ²/h² for white noise at even spacing.
 constexpr double kSplineNoiseGain = 1.392;
-// w₃·w_s·h² of the 3-point rate's and the spline's slope weights at even spacing: the spline's
-// weights on the neighbours are ±(3/√12)(1 − r²), r = √3 − 2, so their covariance is
-// 0.804·σ²/h² (and the two rates differ by noise of σ²(0.5 + 1.392 − 2·0.804)/h² = 0.285·σ²/h²).
-constexpr double kThreeSplineCovariance = 0.804;
+// The rates ReviseLocalSamples weighs against the fit's: the 3-point one, the 5-point one and the
+// spline's slopes, and w_x·w_s·h², their weights' product with the spline's at even spacing. The
+// spline's weights on the samples 1 and 2 away are ±(3/h)(a₀ − a₂) = ±0.804/h and ±(3/h)(a₁ − a₃)
+// = ∓0.215/h, a_k = r^|k|/√12, r = √3 − 2; the 3-point rate's are ±1/(2h), so 0.804 (the two rates
+// differ by noise of σ²(0.5 + 1.392 − 2·0.804)/h² = 0.285·σ²/h²), the 5-point rate's ±8/(12h) and
+// ∓1/(12h), so (2·8·0.804 + 2·0.215)/12 = 1.108; the spline's own, 1.392.
+constexpr Eigen::Index kCandidates = 3;
+constexpr std::array<double, kCandidates> kSplineCovariance{0.804, 1.108, 1.392};
+// The most the 5-point rate's mean squared departure from the spline's slopes may exceed its noise
+// by, as a factor, for the spline's slopes to serve as the reference (ReviseLocalSamples).
+constexpr double kReferenceNoise = 4.0;
 // Windows on either side of a window pooled into the 3-point rate's gain over the curve's rate,
 // and the standard errors of the pooled mean (from the windows' scatter) it must pass by.
 constexpr Eigen::Index kPooledGainWindows = 8;
@@ -267,7 +275,7 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
   const auto count = static_cast<Eigen::Index>(segment.windows.size());
   LocalRates rates{Eigen::ArrayXXi::Constant(count, d, 3),
                    Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(count, d, false), Eigen::MatrixXd(),
-                   Eigen::MatrixXd()};
+                   Eigen::MatrixXd(), Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>::Constant(count, d, false)};
   // Per window: the held-out errors' sums of squares of the polynomials through 2, 3 and 4
   // neighbours on either side (degree 3, 5, 7) at the samples where all exist, their noise gains,
   // and Σ 1/h² (the 3-point rate's noise).
@@ -392,6 +400,7 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
         rates.stencil(k, c) = kSpline;
       }
       rates.under_resolved(k, c) = falls && above && missed > 0.0 && missed * frequency * frequency > best;
+      rates.modelled(k, c) = falls;
     }
   }
   rates.spline_slopes = std::move(spline_rates);
@@ -682,31 +691,57 @@ std::vector<LocalRun> BuildLocalRuns(const Eigen::VectorXd& t, const Eigen::Matr
   return BuildRuns(t, z, first, last - first, chosen.local, chosen.five, chosen.spline, fit_values, fit_rates, noise);
 }
 
-bool AddThreePointSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index last,
+bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index last,
                           const CurveSegment& segment, const LocalRates& rates, const Eigen::MatrixXd& fit_rates,
                           const NoiseProfile& noise, const std::vector<LocalRun>& regression, LocalSamples* chosen) {
   const Eigen::Index n = last - first, d = z.cols();
   const std::vector<CurveWindow>& windows = segment.windows;
   const auto count = static_cast<Eigen::Index>(windows.size());
   if (n < 3 || count == 0 || rates.spline_slopes.rows() != n || rates.three_rates.rows() != n) return false;
-  // The samples and coordinates whose rate is the windows' fit: not local, and in no run of the
-  // local regression.
-  Flags open = !chosen->local;
+  // The samples and coordinates open to a new rate: those the local regression left, except local
+  // ones whose stencil the held-out errors' model chose knowing the motion's frequency (their
+  // orders fell: UnderResolvedRates). Without noise the spline's bias is what the comparison below
+  // would see.
+  const std::vector<Eigen::Index> owner = SampleWindows(t, first, n, windows);
+  Flags open = Flags::Constant(n, d, true);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (Eigen::Index c = 0; c < d; ++c) {
+      open(i, c) = !(chosen->local(i, c) && rates.modelled(owner[static_cast<size_t>(i)], c));
+    }
+  }
   for (const LocalRun& run : regression) {
     const double* begin = t.data() + first;
     const auto from = std::lower_bound(begin, begin + n, run.times.front()) - begin;
     const auto to = std::upper_bound(begin, begin + n, run.times.back()) - begin;
     if (to > from) open.middleRows(from, to - from).setConstant(false);
   }
-  // Per window, over its core's interior samples: per coordinate over the open ones, Σ (r_s − r)²
-  // for the fit's rate r, Σ (r_s − r₃)², the 3-point rate's gain Σ (r_s − r)² − (r_s − r₃)² and
-  // their count; over all, their count, Σ 1/h² (h half the span of a sample's neighbours) and the
-  // shortest and longest step after them.
-  Eigen::MatrixXd departures = Eigen::MatrixXd::Zero(count, d), threes = departures, gains = departures;
-  Eigen::MatrixXd counted = departures;
+  const std::vector<Eigen::Index> starts = WindowStarts(owner, count);
+  Eigen::MatrixXd window_sigma(count, d);
+  for (Eigen::Index k = 0; k < count; ++k) window_sigma.row(k) = NoiseOver(noise, first, starts, k, k).transpose();
+  // The fit's rate noise |w|² per window near an unresolved one (RateNoiseGains).
+  std::vector<char> near(static_cast<size_t>(count), 0);
+  for (Eigen::Index k = 0; k < count; ++k) {
+    if (JudgingWindow(windows, static_cast<size_t>(k), d).verdict != WindowVerdict::kUnresolved) continue;
+    for (Eigen::Index j = std::max<Eigen::Index>(0, k - kPooledGainWindows); j <= std::min(count - 1, k + kPooledGainWindows); ++j) {
+      near[static_cast<size_t>(j)] = 1;
+    }
+  }
+  Eigen::MatrixXd fit_noise = Eigen::MatrixXd::Zero(count, d);
+  for (Eigen::Index j = 0; j < count; ++j) {
+    if (!near[static_cast<size_t>(j)]) continue;
+    const Eigen::VectorXd rate_noise = RateNoiseGains(t, z, windows[static_cast<size_t>(j)]);
+    if (rate_noise.size() == d) fit_noise.row(j) = rate_noise.transpose();
+  }
+  // Per window, over its core's open interior samples: per candidate rate r_x Σ (r_s − r_x)² and
+  // its gain over the samples' present rate r (the fit's, or the local stencil's),
+  // Σ (r_s − r)² − (r_s − r_x)² + 2σ²·w·w_s (w·w_s ≈ |w|² for the fit: the spline's slopes follow
+  // the window's smooth weights; w_y·w_s for a stencil y), per coordinate; their count, Σ 1/h² (h
+  // half the span of a sample's neighbours) and the shortest and longest step after them.
+  std::array<Eigen::MatrixXd, kCandidates> squares, gains;
+  for (Eigen::Index x = 0; x < kCandidates; ++x) squares[x] = gains[x] = Eigen::MatrixXd::Zero(count, d);
+  Eigen::MatrixXd counted = Eigen::MatrixXd::Zero(count, d);
   Eigen::VectorXd samples = Eigen::VectorXd::Zero(count), inverse_h2 = samples, longest = samples;
   Eigen::VectorXd shortest = Eigen::VectorXd::Constant(count, std::numeric_limits<double>::infinity());
-  const std::vector<Eigen::Index> owner = SampleWindows(t, first, n, windows);
   for (Eigen::Index i = 1; i + 1 < n; ++i) {
     const Eigen::Index w = owner[static_cast<size_t>(i)];
     samples[w] += 1.0;
@@ -717,36 +752,27 @@ bool AddThreePointSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Ei
     longest[w] = std::max(longest[w], step);
     for (Eigen::Index c = 0; c < d; ++c) {
       if (!open(i, c)) continue;
-      const double departure = std::pow(rates.spline_slopes(i, c) - fit_rates(first + i, c), 2);
-      const double three = std::pow(rates.spline_slopes(i, c) - rates.three_rates(i, c), 2);
-      departures(w, c) += departure;
-      threes(w, c) += three;
-      gains(w, c) += departure - three;
       counted(w, c) += 1.0;
+      // The candidates' rates: the 3-point one, the 5-point one (the 3-point one beside the
+      // ends), the spline's slopes.
+      const double spline = rates.spline_slopes(i, c), three = rates.three_rates(i, c);
+      const double five = i >= 2 && i + 2 < n ? LagrangeRate(t, z, first + i, c, first + i - 2, first + i + 2) : three;
+      const std::array<double, kCandidates> candidates{three, five, spline};
+      const Eigen::Index present = !chosen->local(i, c) ? -1 : chosen->five(i, c) ? 1 : chosen->spline(i, c) ? 2 : 0;
+      const double rate = present < 0 ? fit_rates(first + i, c) : candidates[static_cast<size_t>(present)];
+      const double variance = window_sigma(w, c) * window_sigma(w, c);
+      const double shared = 2.0 * variance * (present < 0 ? fit_noise(w, c) : kSplineCovariance[present] / (h * h));
+      for (Eigen::Index x = 0; x < kCandidates; ++x) {
+        const double square = std::pow(spline - candidates[static_cast<size_t>(x)], 2);
+        squares[x](w, c) += square;
+        gains[x](w, c) += std::pow(spline - rate, 2) - square + shared;
+      }
     }
   }
-  const std::vector<Eigen::Index> starts = WindowStarts(owner, count);
-  // The fit's rate noise, which the spline's slopes share: E(r_s − r)² = b² + σ²(|w_s|² + |w|² −
-  // 2w·w_s), and w·w_s ≈ |w|² (the spline's slopes follow the window's smooth weights). So the
-  // gains of windows near an unresolved one take 2σ²|w|² per sample, its rate noise (RateNoiseGains).
-  std::vector<char> near(static_cast<size_t>(count), 0);
-  for (Eigen::Index k = 0; k < count; ++k) {
-    if (JudgingWindow(windows, static_cast<size_t>(k), d).verdict != WindowVerdict::kUnresolved) continue;
-    for (Eigen::Index j = std::max<Eigen::Index>(0, k - kPooledGainWindows); j <= std::min(count - 1, k + kPooledGainWindows); ++j) {
-      near[static_cast<size_t>(j)] = 1;
-    }
-  }
-  for (Eigen::Index j = 0; j < count; ++j) {
-    if (!near[static_cast<size_t>(j)] || !(counted.row(j).array() > 0.0).any()) continue;
-    const Eigen::VectorXd rate_noise = RateNoiseGains(t, z, windows[static_cast<size_t>(j)]);
-    if (rate_noise.size() != d) continue;
-    const Eigen::VectorXd sigma = NoiseOver(noise, first, starts, j, j);
-    gains.row(j) += 2.0 * counted.row(j).cwiseProduct(sigma.cwiseAbs2().cwiseProduct(rate_noise).transpose());
-  }
-  bool added = false;
+  bool changed = false;
   for (Eigen::Index k = 0; k < count; ++k) {
     const CurveWindow& window = JudgingWindow(windows, static_cast<size_t>(k), d);
-    if (window.verdict != WindowVerdict::kUnresolved || window.residual_rms.size() != d) continue;
+    if (window.verdict != WindowVerdict::kUnresolved || window.residual_rms.size() != d || !(samples[k] > 0.0)) continue;
     const Eigen::Index a = std::max<Eigen::Index>(0, k - kPooledGainWindows);
     const Eigen::Index b = std::min(count - 1, k + kPooledGainWindows), pooled_count = b - a + 1;
     const double pooled = samples.segment(a, pooled_count).sum();
@@ -757,37 +783,60 @@ bool AddThreePointSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Ei
     }
     const double mean_inverse_h2 = inverse_h2.segment(a, pooled_count).sum() / pooled;
     const Eigen::VectorXd pooled_sigma = NoiseOver(noise, first, starts, a, b);
-    const Eigen::VectorXd sigma = NoiseOver(noise, first, starts, k, k);
+    const Eigen::Index core_begin = std::max<Eigen::Index>(1, starts[static_cast<size_t>(k)]);
+    const Eigen::Index core_end = std::min(n - 1, starts[static_cast<size_t>(k + 1)]);
     for (Eigen::Index c = 0; c < d; ++c) {
       const double open_pooled = counted.col(c).segment(a, pooled_count).sum();
       if (!(counted(k, c) > 0.0) || open_pooled < kMinHeldOut) continue;
       if (!(window.samples > window.degrees[static_cast<size_t>(c)] + 1)) continue;
-      // With the spline's slopes as the reference of little bias, the fit's squared rate error
-      // is its mean departure d from them less σ²|w_s|² plus 2σ²·w·w_s (above), the 3-point rate's
-      // its departure d₃ plus σ²(2·w₃·w_s − |w_s|²): the 3-point rate is better where
-      // d + 2σ²·w·w_s − d₃ > 2σ²·w₃·w_s, and the spline's slopes are better still where
-      // d₃ > 2σ²(|w_s|² − w₃·w_s).
+      // With the spline's slopes as the reference of little bias, a candidate's squared rate
+      // error is its mean departure d_x from them plus σ²(2·w_x·w_s − |w_s|²), and the present
+      // rate's its departure d less σ²|w_s|² plus 2σ²·w·w_s. The candidate of least error replaces
+      // the present rate where d + 2σ²·w·w_s − d_x > 2σ²·w_x·w_s by two standard errors.
       const double unit_noise = pooled_sigma[c] * pooled_sigma[c] * mean_inverse_h2;  // σ²/h²
-      if (!GainStandsOut(gains.col(c), counted.col(c), a, b, 2.0 * kThreeSplineCovariance * unit_noise)) continue;
-      // And the window's missed motion must be able to hold its departure (DepartsFromSpline).
-      const double departure = departures.col(c).segment(a, pooled_count).sum() / open_pooled;
-      const double missed = MissedMotion(window, c, sigma[c] * sigma[c]);
-      if (missed * std::numbers::pi * std::numbers::pi * mean_inverse_h2 < departure - kSplineNoiseGain * unit_noise) {
+      // The spline's slopes are a reference of little bias where the 5-point rate, whose bias
+      // exceeds theirs at every frequency (15 % of a tone's rate at a quarter of the rate, against
+      // 4.5 %), departs from them by little more than their noise, σ²(|w₅|² + |w_s|² − 2w₅·w_s)
+      // = 0.079·σ²/h² at even spacing: up to kReferenceNoise times that. Where it departs by
+      // more, the biases decide the comparison and the spline's own could (noise-free motion).
+      const double five_departure = squares[1].col(c).segment(a, pooled_count).sum() / open_pooled;
+      if (five_departure > kReferenceNoise * (130.0 / 144.0 + kSplineNoiseGain - 2.0 * kSplineCovariance[1]) * unit_noise) {
         continue;
       }
-      const bool splined = threes.col(c).segment(a, pooled_count).sum() / open_pooled >
-                           2.0 * (kSplineNoiseGain - kThreeSplineCovariance) * unit_noise;
-      for (Eigen::Index i = std::max<Eigen::Index>(1, starts[static_cast<size_t>(k)]);
-           i < std::min(n - 1, starts[static_cast<size_t>(k + 1)]); ++i) {
+      Eigen::Index best = 0;
+      double least = std::numeric_limits<double>::infinity();
+      for (Eigen::Index x = 0; x < kCandidates; ++x) {
+        const double error = squares[x].col(c).segment(a, pooled_count).sum() / open_pooled +
+                             (2.0 * kSplineCovariance[x] - kSplineNoiseGain) * unit_noise;
+        if (error < least) least = error, best = x;
+      }
+      if (!GainStandsOut(gains[best].col(c), counted.col(c), a, b, 2.0 * kSplineCovariance[best] * unit_noise)) continue;
+      // A fit's samples also need the window's missed motion to be able to hold its departure
+      // from the spline's slopes (DepartsFromSpline).
+      bool fit_held = false;
+      double departure = 0.0, held = 0.0;
+      for (Eigen::Index i = core_begin; i < core_end; ++i) {
+        if (!open(i, c) || chosen->local(i, c)) continue;
+        fit_held = true;
+        departure += std::pow(rates.spline_slopes(i, c) - fit_rates(first + i, c), 2);
+        held += 1.0;
+      }
+      if (fit_held) {
+        const double missed = MissedMotion(window, c, window_sigma(k, c) * window_sigma(k, c));
+        if (missed * std::numbers::pi * std::numbers::pi * mean_inverse_h2 < departure / held - kSplineNoiseGain * unit_noise) {
+          continue;
+        }
+      }
+      for (Eigen::Index i = core_begin; i < core_end; ++i) {
         if (!open(i, c)) continue;
+        changed = changed || !chosen->local(i, c) || chosen->five(i, c) != (best == 1) || chosen->spline(i, c) != (best == 2);
         chosen->local(i, c) = true;
-        chosen->five(i, c) = false;
-        chosen->spline(i, c) = splined;
-        added = true;
+        chosen->five(i, c) = best == 1;
+        chosen->spline(i, c) = best == 2;
       }
     }
   }
-  return added;
+  return changed;
 }
 
 }  // namespace cheval::cheb::internal

@@ -31,6 +31,9 @@ struct LocalRates {
   Eigen::MatrixXd spline_slopes;
   /// The 3-point rates at the segment's samples (n x d; empty with the spline's slopes).
   Eigen::MatrixXd three_rates;
+  /// Whether the held-out errors fell with the order (the stencil was chosen knowing the motion's
+  /// frequency), per window and coordinate.
+  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> modelled;
 };
 
 /// The LocalRates of the windows of `segment`. Over the window's core, the held-out errors of the
@@ -104,17 +107,20 @@ std::vector<LocalRun> BuildLocalRuns(const Eigen::VectorXd& t, const Eigen::Matr
                                      Eigen::Index last, const LocalSamples& chosen, const Eigen::MatrixXd& fit_values,
                                      const Eigen::MatrixXd& fit_rates, const NoiseProfile& noise);
 
-/// Adds to a segment's `chosen` local samples, after the local regression (`regression`: its runs,
-/// whose samples it leaves), the samples and coordinates whose rate is the windows' fit where,
-/// pooled over an unresolved window and kPooledGainWindows on either side of even spacing, the
-/// 3-point rate's gain over the fit's rate (`fit_rates`), measured against the spline's slopes as a
-/// reference of little bias with the fit's rate noise counted, exceeds 2σ²·w₃·w_s by two standard
-/// errors of the windows' scatter, and the window's missed motion can hold the fit's departure.
-/// Their rate is the 3-point one, or the spline's slopes where those are better still. Where the
-/// noise dominates motion near a quarter of the rate, windows of ~20 samples miss much of it and
-/// pass their residual test with σ read high, and the spline's noise makes it no better; the
-/// 3-point rate is (docs/velocity.md, "Local interpolant"). Returns whether any sample was added.
-bool AddThreePointSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index last,
+/// Revises a segment's `chosen` local samples after the local regression (`regression`: its runs,
+/// whose samples it leaves). Per unresolved window and coordinate, pooled with kPooledGainWindows
+/// windows on either side of even spacing, the spline's slopes serve as a reference of little bias:
+/// each candidate rate's error (the 3-point, the 5-point, the spline's) is estimated from its mean
+/// squared departure from them and the noise the two share, and the samples' present rate (the
+/// windows' fit, with its rate noise counted; or a local stencil the held-out errors' model chose
+/// without knowing the motion's frequency) gives way to the candidate of least error where its
+/// gain exceeds 2σ²·w_x·w_s by two standard errors of the windows' scatter. Nothing changes where
+/// the 5-point rate departs from the spline's slopes by more than kReferenceNoise times its noise
+/// (the biases, the spline's too, would decide), nor at the fit's samples where the window's
+/// missed motion cannot hold their departure. Where the noise dominates motion near a quarter of
+/// the rate, windows of ~20 samples miss much of it and pass their residual test with σ read high
+/// (docs/velocity.md, "Local interpolant"). Returns whether any sample changed.
+bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index last,
                           const CurveSegment& segment, const LocalRates& rates, const Eigen::MatrixXd& fit_rates,
                           const NoiseProfile& noise, const std::vector<LocalRun>& regression, LocalSamples* chosen);
 
