@@ -29,21 +29,19 @@ constexpr double kMinHeldOut = 8;
 constexpr int kSpline = 9;
 // The variance of the interpolating cubic spline's slopes over σ²/h² for white noise at even spacing.
 constexpr double kSplineNoiseGain = 1.392;
-// The rates ReviseLocalSamples weighs against the fit's: the 3-point one, the 5-point one and the
-// spline's slopes, and w_x·w_s·h², their weights' product with the spline's at even spacing. The
-// spline's weights on the samples 1 and 2 away are ±(3/h)(a₀ − a₂) = ±0.804/h and ±(3/h)(a₁ − a₃)
-// = ∓0.215/h, a_k = r^|k|/√12, r = √3 − 2; the 3-point rate's are ±1/(2h), so 0.804 (the two rates
-// differ by noise of σ²(0.5 + 1.392 − 2·0.804)/h² = 0.285·σ²/h²), the 5-point rate's ±8/(12h) and
-// ∓1/(12h), so (2·8·0.804 + 2·0.215)/12 = 1.108; the spline's own, 1.392.
+// The rates ReviseLocalSamples weighs against the present one: the 3-point one, the 5-point one and
+// the spline's slopes (their noise products with the spline's slopes: RateWeights; at even spacing
+// w_x·w_s·h² = 0.804, 1.108 and 1.392).
 constexpr Eigen::Index kCandidates = 3;
-constexpr std::array<double, kCandidates> kSplineCovariance{0.804, 1.108, 1.392};
 // The most the 5-point rate's mean squared departure from the spline's slopes may exceed its noise
 // by, as a factor, for the spline's slopes to serve as the reference (ReviseLocalSamples).
 constexpr double kReferenceNoise = 4.0;
-// Windows on either side of a window pooled into the 3-point rate's gain over the curve's rate,
+// Windows on either side of a window pooled into a candidate rate's gain over the present rate,
 // and the standard errors of the pooled mean (from the windows' scatter) it must pass by.
 constexpr Eigen::Index kPooledGainWindows = 8;
 constexpr double kGainSignificance = 2.0;
+// Samples on either side of a sample over which the spline's weights there are solved (RateWeights).
+constexpr Eigen::Index kSplineReach = 8;
 // The most core samples over which a window's rate noise is averaged (RateNoiseGains).
 constexpr Eigen::Index kNoiseProbes = 64;
 // Windows on either side of a window pooled into its departure from the spline's slopes: the
@@ -503,6 +501,86 @@ Eigen::VectorXd RateNoiseGains(const Eigen::VectorXd& t, const Eigen::MatrixXd& 
   return gains;
 }
 
+// The noise products at sample i of a segment (from `first`, n samples) of the interpolating
+// spline's slopes with the candidate rates of ReviseLocalSamples, from their weights on the
+// samples: w_x·w_s for the 3-point rate, the 5-point one (where i has two samples on either side;
+// the 3-point one's otherwise) and the spline's (|w_s|²), and |w₅ − w_s|². The spline's weights are
+// the row of A⁻¹B at i for the tridiagonal system of its slopes (SplineSlopes), A⁻ᵀe_i solved over
+// kSplineReach samples on either side (its weights fall by 0.27 per sample at even spacing: 4e-5
+// at the patch's edge, where the slopes are held).
+struct RateWeights {
+  RateWeights(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n, Eigen::Index i) {
+    const Eigen::Index p0 = std::max<Eigen::Index>(1, i - kSplineReach), p1 = std::min(n - 2, i + kSplineReach);
+    const Eigen::Index q = p1 - p0 + 1;
+    auto step = [&](Eigen::Index r) { return t[first + r + 1] - t[first + r]; };  // h_r: r to r + 1
+    // Aᵀy = e_i by Thomas' algorithm: row r of A is h_r·s_{r−1} + 2(h_{r−1} + h_r)·s_r + h_{r−1}·s_{r+1},
+    // so Aᵀ has h_{r+1} below the diagonal of row r + 1... (column r of A).
+    Eigen::VectorXd lower(q), diagonal(q), upper(q), y = Eigen::VectorXd::Zero(q);
+    for (Eigen::Index r = 0; r < q; ++r) {
+      const Eigen::Index row = p0 + r;
+      diagonal[r] = 2.0 * (step(row - 1) + step(row));
+      // Aᵀ(r, r − 1) = A(r − 1, r) = h_{(r−1)−1}; Aᵀ(r, r + 1) = A(r + 1, r) = h_{r+1}.
+      lower[r] = r > 0 ? step(row - 2) : 0.0;
+      upper[r] = r + 1 < q ? step(row + 1) : 0.0;
+    }
+    y[i - p0] = 1.0;
+    for (Eigen::Index r = 1; r < q; ++r) {
+      const double factor = lower[r] / diagonal[r - 1];
+      diagonal[r] -= factor * upper[r - 1];
+      y[r] -= factor * y[r - 1];
+    }
+    y[q - 1] /= diagonal[q - 1];
+    for (Eigen::Index r = q - 2; r >= 0; --r) y[r] = (y[r] - upper[r] * y[r + 1]) / diagonal[r];
+    // w_s over samples p0 − 1 .. p1 + 1: row r of B is 3(h_r·d_{r−1} + h_{r−1}·d_r), d the slopes.
+    lo_ = p0 - 1;
+    Eigen::VectorXd spline = Eigen::VectorXd::Zero(q + 2);
+    for (Eigen::Index r = 0; r < q; ++r) {
+      const Eigen::Index row = p0 + r;
+      const double before = step(row - 1), after = step(row);
+      spline[r] += y[r] * -3.0 * after / before;
+      spline[r + 1] += y[r] * 3.0 * (after / before - before / after);
+      spline[r + 2] += y[r] * 3.0 * before / after;
+    }
+    auto at = [&](Eigen::Index j) { return j >= lo_ && j < lo_ + spline.size() ? spline[j - lo_] : 0.0; };
+    spline_norm = spline.squaredNorm();
+    // The 3-point rate's weights: CentredRate's.
+    const double h0 = step(i - 1), h1 = step(i);
+    const double three = (-h1 / (h0 * (h0 + h1))) * at(i - 1) + ((h1 / h0 - h0 / h1) / (h0 + h1)) * at(i) +
+                         (h0 / (h1 * (h0 + h1))) * at(i + 1);
+    // The 5-point rate's: LagrangeRate's over i − 2 .. i + 2.
+    double five = three, five_norm = 0.0;
+    has_five = i >= 2 && i + 2 < n;
+    if (has_five) {
+      five = 0.0;
+      double own = 0.0;
+      for (Eigen::Index j = i - 2; j <= i + 2; ++j) {
+        if (j == i) continue;
+        own += 1.0 / (t[first + i] - t[first + j]);
+        double weight = 1.0 / (t[first + j] - t[first + i]);
+        for (Eigen::Index l = i - 2; l <= i + 2; ++l) {
+          if (l != j && l != i) weight *= (t[first + i] - t[first + l]) / (t[first + j] - t[first + l]);
+        }
+        five += weight * at(j);
+        five_norm += weight * weight;
+      }
+      five += own * at(i);
+      five_norm += own * own;
+    } else {
+      five_norm = std::pow(h1 / (h0 * (h0 + h1)), 2) + std::pow((h1 / h0 - h0 / h1) / (h0 + h1), 2) +
+                  std::pow(h0 / (h1 * (h0 + h1)), 2);
+    }
+    spline_products = {three, five, spline_norm};
+    five_departure = five_norm + spline_norm - 2.0 * five;
+  }
+
+  std::array<double, kCandidates> spline_products{};
+  double spline_norm = 0.0, five_departure = 0.0;
+  bool has_five = false;
+
+ private:
+  Eigen::Index lo_ = 0;
+};
+
 // Whether the mean per sample of the gains summed per window over windows a..b (`gains`, over
 // `samples` each) exceeds `threshold` by kGainSignificance standard errors, taken from the scatter
 // of the windows' means (the spline's noise correlates neighbouring samples' gains).
@@ -692,19 +770,24 @@ std::vector<LocalRun> BuildLocalRuns(const Eigen::VectorXd& t, const Eigen::Matr
 }
 
 bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index last,
-                          const CurveSegment& segment, const LocalRates& rates, const Eigen::MatrixXd& fit_rates,
-                          const NoiseProfile& noise, const std::vector<LocalRun>& regression, LocalSamples* chosen) {
+                        const CurveSegment& segment, const LocalRates& rates, const Eigen::MatrixXd& fit_rates,
+                        const NoiseProfile& noise, const std::vector<LocalRun>& regression, LocalSamples* chosen) {
   const Eigen::Index n = last - first, d = z.cols();
   const std::vector<CurveWindow>& windows = segment.windows;
   const auto count = static_cast<Eigen::Index>(windows.size());
-  if (n < 3 || count == 0 || rates.spline_slopes.rows() != n || rates.three_rates.rows() != n) return false;
+  if (n < 5 || count == 0 || rates.spline_slopes.rows() != n || rates.three_rates.rows() != n) return false;
   // The samples and coordinates open to a new rate: those the local regression left, except local
   // ones whose stencil the held-out errors' model chose knowing the motion's frequency (their
-  // orders fell: UnderResolvedRates). Without noise the spline's bias is what the comparison below
-  // would see.
+  // orders fell: UnderResolvedRates; without noise the spline's bias is what the comparison below
+  // would see) and samples whose 5-point stencil holds a close step (Close: their local rate is
+  // another).
   const std::vector<Eigen::Index> owner = SampleWindows(t, first, n, windows);
-  Flags open = Flags::Constant(n, d, true);
-  for (Eigen::Index i = 0; i < n; ++i) {
+  const Eigen::VectorXd steps = t.segment(first + 1, n - 1) - t.segment(first, n - 1);
+  Flags open = Flags::Constant(n, d, false);
+  for (Eigen::Index i = 1; i + 1 < n; ++i) {
+    bool close = false;
+    for (Eigen::Index j = std::max<Eigen::Index>(0, i - 2); j <= std::min(n - 2, i + 1); ++j) close = close || Close(steps, j);
+    if (close || !(steps[i - 1] > 0.0) || !(steps[i] > 0.0)) continue;
     for (Eigen::Index c = 0; c < d; ++c) {
       open(i, c) = !(chosen->local(i, c) && rates.modelled(owner[static_cast<size_t>(i)], c));
     }
@@ -732,40 +815,51 @@ bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eige
     const Eigen::VectorXd rate_noise = RateNoiseGains(t, z, windows[static_cast<size_t>(j)]);
     if (rate_noise.size() == d) fit_noise.row(j) = rate_noise.transpose();
   }
-  // Per window, over its core's open interior samples: per candidate rate r_x Σ (r_s − r_x)² and
-  // its gain over the samples' present rate r (the fit's, or the local stencil's),
-  // Σ (r_s − r)² − (r_s − r_x)² + 2σ²·w·w_s (w·w_s ≈ |w|² for the fit: the spline's slopes follow
-  // the window's smooth weights; w_y·w_s for a stencil y), per coordinate; their count, Σ 1/h² (h
-  // half the span of a sample's neighbours) and the shortest and longest step after them.
-  std::array<Eigen::MatrixXd, kCandidates> squares, gains;
-  for (Eigen::Index x = 0; x < kCandidates; ++x) squares[x] = gains[x] = Eigen::MatrixXd::Zero(count, d);
-  Eigen::MatrixXd counted = Eigen::MatrixXd::Zero(count, d);
-  Eigen::VectorXd samples = Eigen::VectorXd::Zero(count), inverse_h2 = samples, longest = samples;
-  Eigen::VectorXd shortest = Eigen::VectorXd::Constant(count, std::numeric_limits<double>::infinity());
+  // Per window and coordinate, over its core's open samples: per candidate rate r_x, Σ (r_s − r_x)²,
+  // Σ σ²(2w_x·w_s − |w_s|²) (the rest of its squared error) and its gain over the samples' present
+  // rate r (the fit's, or the local stencil's), Σ (r_s − r)² − (r_s − r_x)² + 2σ²(w·w_s − w_x·w_s)
+  // (w·w_s ≈ |w|² for the fit: the spline's slopes follow the window's smooth weights); Σ σ²|w_s|²,
+  // Σ σ²|w_s − w₅|², Σ (r_s − r)² at the fit's samples and their count; the open samples' count;
+  // and over all its interior samples, their count and Σ 1/h² (h half the span of a sample's
+  // neighbours).
+  std::array<Eigen::MatrixXd, kCandidates> squares, noises, gains;
+  for (Eigen::Index x = 0; x < kCandidates; ++x) squares[x] = noises[x] = gains[x] = Eigen::MatrixXd::Zero(count, d);
+  Eigen::MatrixXd counted = Eigen::MatrixXd::Zero(count, d), spline_noise = counted, five_noise = counted;
+  Eigen::MatrixXd fit_departures = counted, fit_spline_noise = counted, fit_counted = counted;
+  Eigen::VectorXd samples = Eigen::VectorXd::Zero(count), inverse_h2 = samples;
   for (Eigen::Index i = 1; i + 1 < n; ++i) {
     const Eigen::Index w = owner[static_cast<size_t>(i)];
     samples[w] += 1.0;
     const double h = 0.5 * (t[first + i + 1] - t[first + i - 1]);
     inverse_h2[w] += 1.0 / (h * h);
-    const double step = t[first + i + 1] - t[first + i];
-    shortest[w] = std::min(shortest[w], step);
-    longest[w] = std::max(longest[w], step);
+    if (!open.row(i).any()) continue;
+    const RateWeights weights(t, first, n, i);
     for (Eigen::Index c = 0; c < d; ++c) {
       if (!open(i, c)) continue;
       counted(w, c) += 1.0;
       // The candidates' rates: the 3-point one, the 5-point one (the 3-point one beside the
       // ends), the spline's slopes.
       const double spline = rates.spline_slopes(i, c), three = rates.three_rates(i, c);
-      const double five = i >= 2 && i + 2 < n ? LagrangeRate(t, z, first + i, c, first + i - 2, first + i + 2) : three;
+      const double five = weights.has_five ? LagrangeRate(t, z, first + i, c, first + i - 2, first + i + 2) : three;
       const std::array<double, kCandidates> candidates{three, five, spline};
       const Eigen::Index present = !chosen->local(i, c) ? -1 : chosen->five(i, c) ? 1 : chosen->spline(i, c) ? 2 : 0;
       const double rate = present < 0 ? fit_rates(first + i, c) : candidates[static_cast<size_t>(present)];
       const double variance = window_sigma(w, c) * window_sigma(w, c);
-      const double shared = 2.0 * variance * (present < 0 ? fit_noise(w, c) : kSplineCovariance[present] / (h * h));
+      const double shared = present < 0 ? fit_noise(w, c) : weights.spline_products[static_cast<size_t>(present)];
+      const double departure = std::pow(spline - rate, 2);
       for (Eigen::Index x = 0; x < kCandidates; ++x) {
         const double square = std::pow(spline - candidates[static_cast<size_t>(x)], 2);
+        const double product = weights.spline_products[static_cast<size_t>(x)];
         squares[x](w, c) += square;
-        gains[x](w, c) += std::pow(spline - rate, 2) - square + shared;
+        noises[x](w, c) += variance * (2.0 * product - weights.spline_norm);
+        gains[x](w, c) += departure - square + 2.0 * variance * (shared - product);
+      }
+      spline_noise(w, c) += variance * weights.spline_norm;
+      five_noise(w, c) += variance * weights.five_departure;
+      if (present < 0) {
+        fit_departures(w, c) += departure;
+        fit_spline_noise(w, c) += variance * weights.spline_norm;
+        fit_counted(w, c) += 1.0;
       }
     }
   }
@@ -775,57 +869,36 @@ bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eige
     if (window.verdict != WindowVerdict::kUnresolved || window.residual_rms.size() != d || !(samples[k] > 0.0)) continue;
     const Eigen::Index a = std::max<Eigen::Index>(0, k - kPooledGainWindows);
     const Eigen::Index b = std::min(count - 1, k + kPooledGainWindows), pooled_count = b - a + 1;
-    const double pooled = samples.segment(a, pooled_count).sum();
-    // The constants below hold at even spacing: the steps within kOneSidedSpread of each other.
-    if (pooled < kMinHeldOut ||
-        longest.segment(a, pooled_count).maxCoeff() > kOneSidedSpread * shortest.segment(a, pooled_count).minCoeff()) {
-      continue;
-    }
-    const double mean_inverse_h2 = inverse_h2.segment(a, pooled_count).sum() / pooled;
-    const Eigen::VectorXd pooled_sigma = NoiseOver(noise, first, starts, a, b);
+    const double mean_inverse_h2 = inverse_h2.segment(a, pooled_count).sum() / samples.segment(a, pooled_count).sum();
     const Eigen::Index core_begin = std::max<Eigen::Index>(1, starts[static_cast<size_t>(k)]);
     const Eigen::Index core_end = std::min(n - 1, starts[static_cast<size_t>(k + 1)]);
     for (Eigen::Index c = 0; c < d; ++c) {
       const double open_pooled = counted.col(c).segment(a, pooled_count).sum();
       if (!(counted(k, c) > 0.0) || open_pooled < kMinHeldOut) continue;
       if (!(window.samples > window.degrees[static_cast<size_t>(c)] + 1)) continue;
-      // With the spline's slopes as the reference of little bias, a candidate's squared rate
-      // error is its mean departure d_x from them plus σ²(2·w_x·w_s − |w_s|²), and the present
-      // rate's its departure d less σ²|w_s|² plus 2σ²·w·w_s. The candidate of least error replaces
-      // the present rate where d + 2σ²·w·w_s − d_x > 2σ²·w_x·w_s by two standard errors.
-      const double unit_noise = pooled_sigma[c] * pooled_sigma[c] * mean_inverse_h2;  // σ²/h²
+      auto pooled = [&](const Eigen::MatrixXd& sums) { return sums.col(c).segment(a, pooled_count).sum(); };
       // The spline's slopes are a reference of little bias where the 5-point rate, whose bias
       // exceeds theirs at every frequency (15 % of a tone's rate at a quarter of the rate, against
-      // 4.5 %), departs from them by little more than their noise, σ²(|w₅|² + |w_s|² − 2w₅·w_s)
-      // = 0.079·σ²/h² at even spacing: up to kReferenceNoise times that. Where it departs by
-      // more, the biases decide the comparison and the spline's own could (noise-free motion).
-      const double five_departure = squares[1].col(c).segment(a, pooled_count).sum() / open_pooled;
-      if (five_departure > kReferenceNoise * (130.0 / 144.0 + kSplineNoiseGain - 2.0 * kSplineCovariance[1]) * unit_noise) {
-        continue;
-      }
+      // 4.5 %), departs from them by little more than their noise, σ²|w₅ − w_s|² (0.079·σ²/h² at
+      // even spacing): up to kReferenceNoise times that. Where it departs by more, the biases
+      // decide the comparison and the spline's own could (noise-free motion).
+      if (pooled(squares[1]) > kReferenceNoise * pooled(five_noise)) continue;
+      // With the spline's slopes as the reference, a candidate's squared rate error is its mean
+      // departure from them plus σ²(2·w_x·w_s − |w_s|²). The candidate of least error replaces the
+      // present rate where its gain stands out by two standard errors.
       Eigen::Index best = 0;
       double least = std::numeric_limits<double>::infinity();
       for (Eigen::Index x = 0; x < kCandidates; ++x) {
-        const double error = squares[x].col(c).segment(a, pooled_count).sum() / open_pooled +
-                             (2.0 * kSplineCovariance[x] - kSplineNoiseGain) * unit_noise;
+        const double error = pooled(squares[x]) + pooled(noises[x]);
         if (error < least) least = error, best = x;
       }
-      if (!GainStandsOut(gains[best].col(c), counted.col(c), a, b, 2.0 * kSplineCovariance[best] * unit_noise)) continue;
+      if (!GainStandsOut(gains[best].col(c), counted.col(c), a, b, 0.0)) continue;
       // A fit's samples also need the window's missed motion to be able to hold its departure
-      // from the spline's slopes (DepartsFromSpline).
-      bool fit_held = false;
-      double departure = 0.0, held = 0.0;
-      for (Eigen::Index i = core_begin; i < core_end; ++i) {
-        if (!open(i, c) || chosen->local(i, c)) continue;
-        fit_held = true;
-        departure += std::pow(rates.spline_slopes(i, c) - fit_rates(first + i, c), 2);
-        held += 1.0;
-      }
-      if (fit_held) {
+      // from the spline's slopes less their noise (DepartsFromSpline).
+      if (fit_counted(k, c) > 0.0) {
         const double missed = MissedMotion(window, c, window_sigma(k, c) * window_sigma(k, c));
-        if (missed * std::numbers::pi * std::numbers::pi * mean_inverse_h2 < departure / held - kSplineNoiseGain * unit_noise) {
-          continue;
-        }
+        const double bias = (fit_departures(k, c) - fit_spline_noise(k, c)) / fit_counted(k, c);
+        if (missed * std::numbers::pi * std::numbers::pi * mean_inverse_h2 < bias) continue;
       }
       for (Eigen::Index i = core_begin; i < core_end; ++i) {
         if (!open(i, c)) continue;

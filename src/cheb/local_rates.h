@@ -109,17 +109,18 @@ std::vector<LocalRun> BuildLocalRuns(const Eigen::VectorXd& t, const Eigen::Matr
 
 /// Revises a segment's `chosen` local samples after the local regression (`regression`: its runs,
 /// whose samples it leaves). Per unresolved window and coordinate, pooled with kPooledGainWindows
-/// windows on either side of even spacing, the spline's slopes serve as a reference of little bias:
-/// each candidate rate's error (the 3-point, the 5-point, the spline's) is estimated from its mean
-/// squared departure from them and the noise the two share, and the samples' present rate (the
-/// windows' fit, with its rate noise counted; or a local stencil the held-out errors' model chose
-/// without knowing the motion's frequency) gives way to the candidate of least error where its
-/// gain exceeds 2σ²·w_x·w_s by two standard errors of the windows' scatter. Nothing changes where
-/// the 5-point rate departs from the spline's slopes by more than kReferenceNoise times its noise
-/// (the biases, the spline's too, would decide), nor at the fit's samples where the window's
-/// missed motion cannot hold their departure. Where the noise dominates motion near a quarter of
-/// the rate, windows of ~20 samples miss much of it and pass their residual test with σ read high
-/// (docs/velocity.md, "Local interpolant"). Returns whether any sample changed.
+/// windows on either side, the spline's slopes serve as a reference of little bias: each candidate
+/// rate's error (the 3-point, the 5-point, the spline's) is estimated from its mean squared
+/// departure from them and the noise the two share (from their weights on the stamps), and the
+/// samples' present rate (the windows' fit, with its rate noise counted; or a local stencil the
+/// held-out errors' model chose without knowing the motion's frequency) gives way to the candidate
+/// of least error where its gain stands out by two standard errors of the windows' scatter.
+/// Nothing changes where the 5-point rate departs from the spline's slopes by more than
+/// kReferenceNoise times its noise (the biases, the spline's too, would decide), at samples beside
+/// close steps, nor at the fit's samples where the window's missed motion cannot hold their
+/// departure. Where the noise dominates motion near a quarter of the rate, windows of ~20 samples
+/// miss much of it and pass their residual test with σ read high (docs/velocity.md, "Local
+/// interpolant"). Returns whether any sample changed.
 bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index last,
                           const CurveSegment& segment, const LocalRates& rates, const Eigen::MatrixXd& fit_rates,
                           const NoiseProfile& noise, const std::vector<LocalRun>& regression, LocalSamples* chosen);
