@@ -1100,19 +1100,21 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
               [](const LocalRun& x, const LocalRun& y) { return x.times.front() < y.times.front(); });
   }
 
-  // Where an unresolved window's fit still gives a worse rate than the samples' 3-point rate, the
-  // samples' (docs/velocity.md, "Local interpolant"); the segment's local runs are built again.
+  // Where an unresolved window's fit, or a local stencil chosen without the motion's frequency,
+  // gives a worse rate than one of the samples' local rates, that rate (docs/velocity.md, "Local
+  // interpolant"); the segment's local runs are built again.
   if (!local_samples.empty() && curve.unresolved_windows() > 0) {
     std::vector<LocalRun> regression;
     for (const LocalRun& run : curve.local_runs_) {
       if (run.regression) regression.push_back(run);
     }
-    bool added = false;
+    bool changed = false;
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
-      added = internal::ReviseLocalSamples(t, z, starts[k], starts[k + 1], curve.segments_[k], local_rates[k],
-                                             window_rates, profile, regression, &local_samples[k]) || added;
+      changed = internal::ReviseLocalSamples(t, z, starts[k], starts[k + 1], curve.segments_[k], local_rates[k],
+                                             window_rates, profile, regression, &local_samples[k]) ||
+                changed;
     }
-    if (added) {
+    if (changed) {
       std::vector<LocalRun> runs = std::move(regression);
       for (size_t k = 0; k + 1 < starts.size(); ++k) {
         std::vector<LocalRun> built = internal::BuildLocalRuns(t, z, starts[k], starts[k + 1], local_samples[k],

@@ -124,6 +124,13 @@ std::vector<Eigen::Index> SampleWindows(const Eigen::VectorXd& t, Eigen::Index f
   return owner;
 }
 
+std::pair<Eigen::Index, Eigen::Index> SamplesOf(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
+                                                const LocalRun& run) {
+  const double* begin = t.data() + first;
+  return {std::lower_bound(begin, begin + n, run.times.front()) - begin,
+          std::upper_bound(begin, begin + n, run.times.back()) - begin};
+}
+
 namespace {
 
 // The first of the segment's samples in each of `count` windows' cores, and the sample count after
@@ -793,9 +800,7 @@ bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eige
     }
   }
   for (const LocalRun& run : regression) {
-    const double* begin = t.data() + first;
-    const auto from = std::lower_bound(begin, begin + n, run.times.front()) - begin;
-    const auto to = std::upper_bound(begin, begin + n, run.times.back()) - begin;
+    const auto [from, to] = SamplesOf(t, first, n, run);
     if (to > from) open.middleRows(from, to - from).setConstant(false);
   }
   const std::vector<Eigen::Index> starts = WindowStarts(owner, count);

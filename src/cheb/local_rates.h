@@ -2,6 +2,7 @@
 // Internal to the cheb library: where a fitted segment could not resolve the motion, the curve
 // follows the samples themselves (src/cheb/local_rates.cc; docs/velocity.md, "Local interpolant").
 
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -16,6 +17,10 @@ class NoiseProfile;
 /// last window whose core begins at or before the sample, the first window before that.
 std::vector<Eigen::Index> SampleWindows(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
                                         const std::vector<CurveWindow>& windows);
+
+/// The samples of a segment (n from `first` in the sorted stamps `t`) that a run spans, [from, to).
+std::pair<Eigen::Index, Eigen::Index> SamplesOf(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
+                                                const LocalRun& run);
 
 /// Per window of a segment (rows) and coordinate (columns): the samples' local rate, 3 (the
 /// derivative of the quadratic through a sample and its neighbours), 5 (of the quartic through it
@@ -122,7 +127,7 @@ std::vector<LocalRun> BuildLocalRuns(const Eigen::VectorXd& t, const Eigen::Matr
 /// miss much of it and pass their residual test with σ read high (docs/velocity.md, "Local
 /// interpolant"). Returns whether any sample changed.
 bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index last,
-                          const CurveSegment& segment, const LocalRates& rates, const Eigen::MatrixXd& fit_rates,
-                          const NoiseProfile& noise, const std::vector<LocalRun>& regression, LocalSamples* chosen);
+                        const CurveSegment& segment, const LocalRates& rates, const Eigen::MatrixXd& fit_rates,
+                        const NoiseProfile& noise, const std::vector<LocalRun>& regression, LocalSamples* chosen);
 
 }  // namespace cheval::cheb::internal

@@ -353,9 +353,7 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
     if (w > 0 && w + 1 < windows.size() && RegressionMayGain(windows[w])) owner[static_cast<size_t>(i)] = static_cast<int>(w);
   }
   for (const LocalRun& run : taken) {
-    const double* begin = t.data() + first;
-    const auto from = std::lower_bound(begin, begin + n, run.times.front()) - begin;
-    const auto to = std::upper_bound(begin, begin + n, run.times.back()) - begin;
+    const auto [from, to] = SamplesOf(t, first, n, run);
     for (auto i = from; i < to; ++i) owner[static_cast<size_t>(i)] = -1;
   }
   const bool any = std::any_of(owner.begin(), owner.end(), [](int w) { return w >= 0; });
