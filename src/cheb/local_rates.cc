@@ -520,13 +520,12 @@ struct RateWeights {
     const Eigen::Index p0 = std::max<Eigen::Index>(1, i - kSplineReach), p1 = std::min(n - 2, i + kSplineReach);
     const Eigen::Index q = p1 - p0 + 1;
     auto step = [&](Eigen::Index r) { return t[first + r + 1] - t[first + r]; };  // h_r: r to r + 1
-    // Aᵀy = e_i by Thomas' algorithm: row r of A is h_r·s_{r−1} + 2(h_{r−1} + h_r)·s_r + h_{r−1}·s_{r+1},
-    // so Aᵀ has h_{r+1} below the diagonal of row r + 1... (column r of A).
+    // Aᵀy = e_i by Thomas' algorithm. Row r of A is h_r·s_{r−1} + 2(h_{r−1} + h_r)·s_r +
+    // h_{r−1}·s_{r+1}, so Aᵀ(r, r − 1) = A(r − 1, r) = h_{r−2} and Aᵀ(r, r + 1) = A(r + 1, r) = h_{r+1}.
     Eigen::VectorXd lower(q), diagonal(q), upper(q), y = Eigen::VectorXd::Zero(q);
     for (Eigen::Index r = 0; r < q; ++r) {
       const Eigen::Index row = p0 + r;
       diagonal[r] = 2.0 * (step(row - 1) + step(row));
-      // Aᵀ(r, r − 1) = A(r − 1, r) = h_{(r−1)−1}; Aᵀ(r, r + 1) = A(r + 1, r) = h_{r+1}.
       lower[r] = r > 0 ? step(row - 2) : 0.0;
       upper[r] = r + 1 < q ? step(row + 1) : 0.0;
     }
