@@ -33,6 +33,7 @@ constexpr double kSplineNoiseGain = 1.392;
 // the spline's slopes (their noise products with the spline's slopes: RateWeights; at even spacing
 // w_x·w_s·h² = 0.804, 1.108 and 1.392).
 constexpr Eigen::Index kCandidates = 3;
+constexpr Eigen::Index kThree = 0, kFive = 1, kSplineSlopes = 2;
 // The most the 5-point rate's mean squared departure from the spline's slopes may exceed its noise
 // by, as a factor, for the spline's slopes to serve as the reference (ReviseLocalSamples).
 constexpr double kReferenceNoise = 4.0;
@@ -122,6 +123,30 @@ std::vector<Eigen::Index> SampleWindows(const Eigen::VectorXd& t, Eigen::Index f
     owner[static_cast<size_t>(i)] = w;
   }
   return owner;
+}
+
+std::optional<NestedCholesky> FactorWindow(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const CurveWindow& window,
+                                           int degree) {
+  const auto first = std::lower_bound(t.data(), t.data() + t.size(), window.fit_begin) - t.data();
+  const auto last = std::upper_bound(t.data(), t.data() + t.size(), window.fit_end) - t.data();
+  try {
+    return NestedCholesky(BuildNormalEquations(t.segment(first, last - first), z.middleRows(first, last - first), degree,
+                                               window.series.interval),
+                          degree);
+  } catch (const ComputeError&) {
+    return std::nullopt;
+  }
+}
+
+void ChebyshevSlopes(double x, double scale, Eigen::Ref<Eigen::VectorXd> slopes) {
+  double u_previous = 0.0, u_current = 1.0;  // U_{-1}, U_0
+  if (slopes.size() > 0) slopes[0] = 0.0;
+  for (Eigen::Index k = 1; k < slopes.size(); ++k) {
+    slopes[k] = static_cast<double>(k) * u_current;
+    const double next = 2.0 * x * u_current - u_previous;
+    u_previous = u_current, u_current = next;
+  }
+  slopes *= scale;
 }
 
 std::pair<Eigen::Index, Eigen::Index> SamplesOf(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
@@ -257,9 +282,11 @@ const CurveWindow& JudgingWindow(const std::vector<CurveWindow>& windows, size_t
 
 // The derivative at sample i of the polynomial through samples lo .. hi (distinct stamps; i among
 // them): the quartic through i − 2 .. i + 2 in the interior, one-sided at a segment's end.
-double LagrangeRate(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index i, Eigen::Index c, Eigen::Index lo,
-                    Eigen::Index hi) {
-  double rate = 0.0, own = 0.0;
+// The weights (samples lo .. hi) of that derivative: the derivative at t_i of the Lagrange
+// polynomials of the stamps.
+Eigen::VectorXd LagrangeWeights(const Eigen::VectorXd& t, Eigen::Index i, Eigen::Index lo, Eigen::Index hi) {
+  Eigen::VectorXd weights(hi - lo + 1);
+  double own = 0.0;
   for (Eigen::Index j = lo; j <= hi; ++j) {
     if (j == i) continue;
     own += 1.0 / (t[i] - t[j]);
@@ -267,9 +294,20 @@ double LagrangeRate(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::I
     for (Eigen::Index l = lo; l <= hi; ++l) {
       if (l != j && l != i) weight *= (t[i] - t[l]) / (t[j] - t[l]);
     }
-    rate += weight * z(j, c);
+    weights[j - lo] = weight;
   }
-  return rate + own * z(i, c);
+  weights[i - lo] = own;
+  return weights;
+}
+
+double LagrangeRate(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index i, Eigen::Index c, Eigen::Index lo,
+                    Eigen::Index hi) {
+  const Eigen::VectorXd weights = LagrangeWeights(t, i, lo, hi);
+  double rate = 0.0;
+  for (Eigen::Index j = lo; j <= hi; ++j) {
+    if (j != i) rate += weights[j - lo] * z(j, c);
+  }
+  return rate + weights[i - lo] * z(i, c);
 }
 
 }  // namespace
@@ -479,26 +517,13 @@ Eigen::VectorXd RateNoiseGains(const Eigen::VectorXd& t, const Eigen::MatrixXd& 
   const Eigen::Index last = std::upper_bound(t.data(), t.data() + t.size(), window.fit_end) - t.data();
   const Eigen::Index core_first = at(window.core_begin), core_last = at(window.core_end);
   if (top < 1 || core_last <= core_first || last - first <= top) return gains;
+  const std::optional<NestedCholesky> cholesky = FactorWindow(t, z, window, top);
+  if (!cholesky) return gains;
   const Interval& interval = window.series.interval;
-  std::optional<NestedCholesky> cholesky;
-  try {
-    cholesky.emplace(BuildNormalEquations(t.segment(first, last - first), z.middleRows(first, last - first), top, interval),
-                     top);
-  } catch (const ComputeError&) {
-    return gains;
-  }
-  // T'_k(x) = k·U_{k−1}(x), by the U recurrence.
   const Eigen::Index count = core_last - core_first, probes = std::min(count, kNoiseProbes);
   Eigen::MatrixXd derivatives(top + 1, probes);
   for (Eigen::Index q = 0; q < probes; ++q) {
-    const double x = interval.ToUnit(t[core_first + q * count / probes]);
-    double u_previous = 0.0, u_current = 1.0;  // U_{-1}, U_0
-    derivatives(0, q) = 0.0;
-    for (int k = 1; k <= top; ++k) {
-      derivatives(k, q) = k * u_current * interval.DerivativeScale();
-      const double next = 2.0 * x * u_current - u_previous;
-      u_previous = u_current, u_current = next;
-    }
+    ChebyshevSlopes(interval.ToUnit(t[core_first + q * count / probes]), interval.DerivativeScale(), derivatives.col(q));
   }
   const Eigen::MatrixXd whitened = cholesky->Whiten(top, derivatives);
   for (Eigen::Index c = 0; c < d; ++c) {
@@ -538,7 +563,6 @@ struct RateWeights {
     y[q - 1] /= diagonal[q - 1];
     for (Eigen::Index r = q - 2; r >= 0; --r) y[r] = (y[r] - upper[r] * y[r + 1]) / diagonal[r];
     // w_s over samples p0 − 1 .. p1 + 1: row r of B is 3(h_r·d_{r−1} + h_{r−1}·d_r), d the slopes.
-    lo_ = p0 - 1;
     Eigen::VectorXd spline = Eigen::VectorXd::Zero(q + 2);
     for (Eigen::Index r = 0; r < q; ++r) {
       const Eigen::Index row = p0 + r;
@@ -547,44 +571,28 @@ struct RateWeights {
       spline[r + 1] += y[r] * 3.0 * (after / before - before / after);
       spline[r + 2] += y[r] * 3.0 * before / after;
     }
-    auto at = [&](Eigen::Index j) { return j >= lo_ && j < lo_ + spline.size() ? spline[j - lo_] : 0.0; };
     spline_norm = spline.squaredNorm();
-    // The 3-point rate's weights: CentredRate's.
-    const double h0 = step(i - 1), h1 = step(i);
-    const double three = (-h1 / (h0 * (h0 + h1))) * at(i - 1) + ((h1 / h0 - h0 / h1) / (h0 + h1)) * at(i) +
-                         (h0 / (h1 * (h0 + h1))) * at(i + 1);
-    // The 5-point rate's: LagrangeRate's over i − 2 .. i + 2.
-    double five = three, five_norm = 0.0;
+    // w·w_s for the weights of the polynomial through samples i − half .. i + half (the 3-point
+    // rate: CentredRate's; the 5-point one: LagrangeRate's), and |w|².
+    auto product = [&](Eigen::Index half, double* norm) {
+      const Eigen::VectorXd weights = LagrangeWeights(t, first + i, first + i - half, first + i + half);
+      *norm = weights.squaredNorm();
+      return weights.dot(spline.segment(i - half - (p0 - 1), 2 * half + 1));
+    };
+    double three_norm = 0.0, five_norm = 0.0;
+    const double three = product(1, &three_norm);
     has_five = i >= 2 && i + 2 < n;
-    if (has_five) {
-      five = 0.0;
-      double own = 0.0;
-      for (Eigen::Index j = i - 2; j <= i + 2; ++j) {
-        if (j == i) continue;
-        own += 1.0 / (t[first + i] - t[first + j]);
-        double weight = 1.0 / (t[first + j] - t[first + i]);
-        for (Eigen::Index l = i - 2; l <= i + 2; ++l) {
-          if (l != j && l != i) weight *= (t[first + i] - t[first + l]) / (t[first + j] - t[first + l]);
-        }
-        five += weight * at(j);
-        five_norm += weight * weight;
-      }
-      five += own * at(i);
-      five_norm += own * own;
-    } else {
-      five_norm = std::pow(h1 / (h0 * (h0 + h1)), 2) + std::pow((h1 / h0 - h0 / h1) / (h0 + h1), 2) +
-                  std::pow(h0 / (h1 * (h0 + h1)), 2);
-    }
-    spline_products = {three, five, spline_norm};
+    const double five = has_five ? product(2, &five_norm) : three;
+    if (!has_five) five_norm = three_norm;
+    spline_products[kThree] = three;
+    spline_products[kFive] = five;
+    spline_products[kSplineSlopes] = spline_norm;
     five_departure = five_norm + spline_norm - 2.0 * five;
   }
 
   std::array<double, kCandidates> spline_products{};
   double spline_norm = 0.0, five_departure = 0.0;
   bool has_five = false;
-
- private:
-  Eigen::Index lo_ = 0;
 };
 
 // Whether the mean per sample of the gains summed per window over windows a..b (`gains`, over
@@ -822,13 +830,14 @@ bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eige
   // Per window and coordinate, over its core's open samples: per candidate rate r_x, Σ (r_s − r_x)²,
   // Σ σ²(2w_x·w_s − |w_s|²) (the rest of its squared error) and its gain over the samples' present
   // rate r (the fit's, or the local stencil's), Σ (r_s − r)² − (r_s − r_x)² + 2σ²(w·w_s − w_x·w_s)
-  // (w·w_s ≈ |w|² for the fit: the spline's slopes follow the window's smooth weights); Σ σ²|w_s|²,
-  // Σ σ²|w_s − w₅|², Σ (r_s − r)² at the fit's samples and their count; the open samples' count;
+  // (w·w_s ≈ |w|² for the fit: the spline's slopes follow the window's smooth weights);
+  // Σ σ²|w_s − w₅|²; at the fit's samples Σ (r_s − r)², Σ σ²|w_s|² and their count; the open
+  // samples' count;
   // and over all its interior samples, their count and Σ 1/h² (h half the span of a sample's
   // neighbours).
   std::array<Eigen::MatrixXd, kCandidates> squares, noises, gains;
   for (Eigen::Index x = 0; x < kCandidates; ++x) squares[x] = noises[x] = gains[x] = Eigen::MatrixXd::Zero(count, d);
-  Eigen::MatrixXd counted = Eigen::MatrixXd::Zero(count, d), spline_noise = counted, five_noise = counted;
+  Eigen::MatrixXd counted = Eigen::MatrixXd::Zero(count, d), five_noise = counted;
   Eigen::MatrixXd fit_departures = counted, fit_spline_noise = counted, fit_counted = counted;
   Eigen::VectorXd samples = Eigen::VectorXd::Zero(count), inverse_h2 = samples;
   for (Eigen::Index i = 1; i + 1 < n; ++i) {
@@ -845,8 +854,12 @@ bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eige
       // ends), the spline's slopes.
       const double spline = rates.spline_slopes(i, c), three = rates.three_rates(i, c);
       const double five = weights.has_five ? LagrangeRate(t, z, first + i, c, first + i - 2, first + i + 2) : three;
-      const std::array<double, kCandidates> candidates{three, five, spline};
-      const Eigen::Index present = !chosen->local(i, c) ? -1 : chosen->five(i, c) ? 1 : chosen->spline(i, c) ? 2 : 0;
+      std::array<double, kCandidates> candidates{};
+      candidates[kThree] = three, candidates[kFive] = five, candidates[kSplineSlopes] = spline;
+      const Eigen::Index present = !chosen->local(i, c)   ? -1
+                                   : chosen->five(i, c)   ? kFive
+                                   : chosen->spline(i, c) ? kSplineSlopes
+                                                          : kThree;
       const double rate = present < 0 ? fit_rates(first + i, c) : candidates[static_cast<size_t>(present)];
       const double variance = window_sigma(w, c) * window_sigma(w, c);
       const double shared = present < 0 ? fit_noise(w, c) : weights.spline_products[static_cast<size_t>(present)];
@@ -858,7 +871,6 @@ bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eige
         noises[x](w, c) += variance * (2.0 * product - weights.spline_norm);
         gains[x](w, c) += departure - square + 2.0 * variance * (shared - product);
       }
-      spline_noise(w, c) += variance * weights.spline_norm;
       five_noise(w, c) += variance * weights.five_departure;
       if (present < 0) {
         fit_departures(w, c) += departure;
@@ -886,7 +898,7 @@ bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eige
       // 4.5 %), departs from them by little more than their noise, σ²|w₅ − w_s|² (0.079·σ²/h² at
       // even spacing): up to kReferenceNoise times that. Where it departs by more, the biases
       // decide the comparison and the spline's own could (noise-free motion).
-      if (pooled(squares[1]) > kReferenceNoise * pooled(five_noise)) continue;
+      if (pooled(squares[kFive]) > kReferenceNoise * pooled(five_noise)) continue;
       // With the spline's slopes as the reference, a candidate's squared rate error is its mean
       // departure from them plus σ²(2·w_x·w_s − |w_s|²). The candidate of least error replaces the
       // present rate where its gain stands out by two standard errors.
@@ -906,10 +918,11 @@ bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eige
       }
       for (Eigen::Index i = core_begin; i < core_end; ++i) {
         if (!open(i, c)) continue;
-        changed = changed || !chosen->local(i, c) || chosen->five(i, c) != (best == 1) || chosen->spline(i, c) != (best == 2);
+        changed = changed || !chosen->local(i, c) || chosen->five(i, c) != (best == kFive) ||
+                  chosen->spline(i, c) != (best == kSplineSlopes);
         chosen->local(i, c) = true;
-        chosen->five(i, c) = best == 1;
-        chosen->spline(i, c) = best == 2;
+        chosen->five(i, c) = best == kFive;
+        chosen->spline(i, c) = best == kSplineSlopes;
       }
     }
   }

@@ -2,12 +2,14 @@
 // Internal to the cheb library: where a fitted segment could not resolve the motion, the curve
 // follows the samples themselves (src/cheb/local_rates.cc; docs/velocity.md, "Local interpolant").
 
+#include <optional>
 #include <utility>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "cheval/cheb/curve.h"
+#include "cheval/cheb/fit.h"
 
 namespace cheval::cheb::internal {
 
@@ -17,6 +19,15 @@ class NoiseProfile;
 /// last window whose core begins at or before the sample, the first window before that.
 std::vector<Eigen::Index> SampleWindows(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
                                         const std::vector<CurveWindow>& windows);
+
+/// The factor of the normal matrix, up to `degree`, of `window`'s samples (in the sorted stamps `t`,
+/// s, and values `z`), or none where it is singular (ComputeError).
+std::optional<NestedCholesky> FactorWindow(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const CurveWindow& window,
+                                           int degree);
+
+/// `scale`·T'_k(x) = `scale`·k·U_{k−1}(x) for k = 0 .. slopes.size() − 1: the Chebyshev polynomials'
+/// derivatives at x in [−1, 1], by the U recurrence (`scale` the interval's DerivativeScale gives d/dt).
+void ChebyshevSlopes(double x, double scale, Eigen::Ref<Eigen::VectorXd> slopes);
 
 /// The samples of a segment (n from `first` in the sorted stamps `t`) that a run spans, [from, to).
 std::pair<Eigen::Index, Eigen::Index> SamplesOf(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,

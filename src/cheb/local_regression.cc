@@ -13,7 +13,6 @@
 #include <Eigen/Cholesky>
 
 #include "cheval/cheb/fit.h"
-#include "cheval/common/error.h"
 
 namespace cheval::cheb::internal {
 namespace {
@@ -177,17 +176,8 @@ size_t HalfIndex(int half) {
 class WindowWeights {
  public:
   WindowWeights(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const CurveWindow& window) : window_(window) {
-    const auto first = std::lower_bound(t.data(), t.data() + t.size(), window.fit_begin) - t.data();
-    const auto last = std::upper_bound(t.data(), t.data() + t.size(), window.fit_end) - t.data();
     top_ = *std::max_element(window.degrees.begin(), window.degrees.end());
-    if (top_ < 1) return;
-    try {
-      const NormalEquations normal =
-          BuildNormalEquations(t.segment(first, last - first), z.middleRows(first, last - first), top_, window.series.interval);
-      cholesky_.emplace(normal, top_);
-    } catch (const ComputeError&) {
-      cholesky_.reset();
-    }
+    if (top_ >= 1) cholesky_ = FactorWindow(t, z, window, top_);
   }
 
   // w_W·w_P per coordinate at time ti for the pilot `pilot` (on the segment's samples `ts`), and
@@ -213,15 +203,7 @@ class WindowWeights {
         u[k] += w * current;
       }
     }
-    const double x = interval.ToUnit(ti);
-    double u_previous = 0.0, u_current = 1.0;  // U_{-1}, U_0
-    derivative[0] = 0.0;
-    for (int k = 1; k <= top_; ++k) {
-      derivative[k] = k * u_current;
-      const double next = 2.0 * x * u_current - u_previous;
-      u_previous = u_current, u_current = next;
-    }
-    derivative *= interval.DerivativeScale();
+    ChebyshevSlopes(interval.ToUnit(ti), interval.DerivativeScale(), derivative);
     // T'ᵀG⁻¹u and T'ᵀG⁻¹T' at each coordinate's degree from one forward solve of each (NestedCholesky::Whiten).
     const Eigen::VectorXd whitened_u = cholesky_->Whiten(top_, u), whitened_derivative = cholesky_->Whiten(top_, derivative);
     for (Eigen::Index c = 0; c < d; ++c) {
