@@ -1,0 +1,86 @@
+// The local interpolant's rates at defects the jump search leaves (src/cheb/local_rates.cc;
+// docs/velocity.md, "Local interpolant"): a small step of the values is taken out of the slopes
+// around it; a displaced sample has both of its slopes left out and takes the secant across it.
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "local_rates.h"
+#include "noise_profile.h"
+
+namespace cheval::cheb::internal {
+namespace {
+
+constexpr double kRate = 100.0, kNoise = 1e-5;
+
+// One coordinate of smooth motion, 0.2 m/s at 0.3 Hz, sampled at kRate with noise kNoise, and its
+// true rate.
+struct Samples {
+  Eigen::VectorXd t;
+  Eigen::MatrixXd z, rate;
+};
+
+Samples Smooth(Eigen::Index m, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> gauss(0.0, kNoise);
+  const double w = 2.0 * M_PI * 0.3, amplitude = 0.2 / w;
+  Samples s{Eigen::VectorXd(m), Eigen::MatrixXd(m, 1), Eigen::MatrixXd(m, 1)};
+  for (Eigen::Index i = 0; i < m; ++i) {
+    s.t[i] = static_cast<double>(i) / kRate;
+    s.z(i, 0) = amplitude * std::sin(w * s.t[i]) + gauss(rng);
+    s.rate(i, 0) = amplitude * w * std::cos(w * s.t[i]);
+  }
+  return s;
+}
+
+// The rates of one run over every sample, each local with the 3-point rate.
+Eigen::VectorXd LocalRatesOf(const Samples& s) {
+  const Eigen::Index m = s.t.size();
+  using Flags = Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>;
+  const LocalSamples chosen{Flags::Constant(m, 1, true), Flags::Constant(m, 1, false), Flags::Constant(m, 1, false)};
+  const Eigen::MatrixXd fit = Eigen::MatrixXd::Zero(m, 1);
+  const std::vector<LocalRun> runs =
+      BuildLocalRuns(s.t, s.z, 0, m, chosen, fit, fit, NoiseProfile(Eigen::VectorXd::Constant(1, kNoise)));
+  EXPECT_EQ(runs.size(), 1u);
+  if (runs.size() != 1 || runs.front().rates.rows() != m) return Eigen::VectorXd::Zero(m);
+  return runs.front().rates.col(0);
+}
+
+// A sample displaced by ε moves both of its slopes by ε/h, opposite ways: which of the two the
+// spike test found the larger was chance, and the one left in carried the displacement into the
+// rate at the sample (ε/h) and at one neighbour (ε/2h). Both are left out now: the sample takes the
+// secant across it, its neighbours the quadratic on their other side.
+TEST(LocalRates, ADisplacedSampleLeavesBothOfItsSlopes) {
+  constexpr double kDisplacement = 5e-4;  // 50σ, 0.05 m/s over a step
+  for (uint64_t seed = 1; seed <= 6; ++seed) {
+    Samples s = Smooth(200, seed);
+    const Eigen::Index at = 100;
+    s.z(at, 0) += (seed % 2 == 0 ? 1.0 : -1.0) * kDisplacement;
+    const Eigen::VectorXd rates = LocalRatesOf(s);
+    const double slope_shift = kDisplacement * kRate;  // 0.05 m/s
+    for (Eigen::Index i = at - 1; i <= at + 1; ++i) {
+      EXPECT_LT(std::abs(rates[i] - s.rate(i, 0)), 0.1 * slope_shift) << "seed " << seed << ", sample " << i - at;
+    }
+  }
+}
+
+// A step δ of the values between two samples moves one slope by δ/h and departs its neighbours
+// by half that the other way: only that slope is left out, and the samples on either side keep
+// their rates from their own side.
+TEST(LocalRates, ASmallStepLeavesOnlyItsSlope) {
+  constexpr double kStep = 5e-4;
+  for (uint64_t seed = 1; seed <= 6; ++seed) {
+    Samples s = Smooth(200, seed);
+    const Eigen::Index after = 101;
+    s.z.bottomRows(s.z.rows() - after).array() += (seed % 2 == 0 ? 1.0 : -1.0) * kStep;
+    const Eigen::VectorXd rates = LocalRatesOf(s);
+    for (Eigen::Index i = after - 2; i <= after + 1; ++i) {
+      EXPECT_LT(std::abs(rates[i] - s.rate(i, 0)), 0.1 * kStep * kRate) << "seed " << seed << ", sample " << i - after;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace cheval::cheb::internal
