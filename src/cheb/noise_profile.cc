@@ -10,20 +10,30 @@ NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitu
     : level_(level), maximum_(level) {
   const Eigen::Index d = level.size();
   cumulative_ = Eigen::MatrixXd::Zero(m + 1, d);
-  const Eigen::VectorXd raise = kRaise * level;
-  // Where the 4th differences' median over a block's pool cannot exceed the raise (their counts
-  // say so), no median is taken.
-  const Eigen::MatrixXi counts = magnitudes.CountsAbove(raise);
+  const Eigen::VectorXd raise = kRaise * level, burst = kBurst * level;
+  // Where the 4th differences' median over a stretch cannot exceed a threshold (their counts say
+  // so), no median is taken.
+  const Eigen::MatrixXi counts = magnitudes.CountsAbove(raise), burst_counts = magnitudes.CountsAbove(burst);
+  auto may_exceed = [d](const Eigen::MatrixXi& above_counts, Eigen::Index from, Eigen::Index to) {
+    for (Eigen::Index c = 0; c < d; ++c) {
+      const int usable = above_counts(to, 2 * c) - above_counts(from, 2 * c);
+      const int above = above_counts(to, 2 * c + 1) - above_counts(from, 2 * c + 1);
+      if (usable > 0 && above >= usable - usable / 2) return true;
+    }
+    return false;
+  };
   for (Eigen::Index begin = 0; begin < m; begin += kBlock) {
     const Eigen::Index end = std::min(m, begin + kBlock);
     const Eigen::Index from = std::max<Eigen::Index>(0, begin - kPooledBlocks * kBlock);
     const Eigen::Index to = std::min(m, end + kPooledBlocks * kBlock);
-    bool may_raise = false;
-    for (Eigen::Index c = 0; c < d; ++c) {
-      const int usable = counts(to, 2 * c) - counts(from, 2 * c), above = counts(to, 2 * c + 1) - counts(from, 2 * c + 1);
-      may_raise = may_raise || (usable > 0 && above >= usable - usable / 2);
+    Eigen::VectorXd local = may_exceed(counts, from, to) ? magnitudes.SigmaIfAbove(from, to, raise) : level;
+    // A burst shorter than half the pool leaves its median; the block's own estimate shows it.
+    if (may_exceed(burst_counts, begin, end)) {
+      const Eigen::VectorXd own = magnitudes.SigmaIfAbove(begin, end, burst);
+      for (Eigen::Index c = 0; c < d; ++c) {
+        if (own[c] > burst[c]) local[c] = std::max(local[c], own[c]);
+      }
     }
-    const Eigen::VectorXd local = may_raise ? magnitudes.SigmaIfAbove(from, to, raise) : level;
     Eigen::RowVectorXd variance = level.cwiseAbs2().transpose();
     bool raised = false;
     for (Eigen::Index c = 0; c < d; ++c) {

@@ -37,12 +37,15 @@ class DifferenceMagnitudes {
 /// The noise σ per coordinate along the samples: the data's level, raised over blocks of
 /// kBlock samples whose own estimate, pooled over kPooledBlocks blocks on either side, exceeds it
 /// by more than kRaise (a factor the estimate's scatter over that many samples does not reach on
-/// stationary noise).
+/// stationary noise), or whose estimate over the block alone exceeds it by more than kBurst (the
+/// same for the block's scatter, far wider): a burst of noise shorter than half the pool, which
+/// its median does not see (TUM fr2/desk's motion capture: tens of samples at ~10x the level).
 class NoiseProfile {
  public:
   static constexpr Eigen::Index kBlock = 32;
   static constexpr Eigen::Index kPooledBlocks = 2;
   static constexpr double kRaise = 1.5;
+  static constexpr double kBurst = 3.0;
 
   /// The level everywhere.
   explicit NoiseProfile(const Eigen::VectorXd& level);
