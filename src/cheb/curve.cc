@@ -912,7 +912,12 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     if (!options.noise_sigma) magnitudes.emplace(t, z, gaps);
     noise = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
                                 : magnitudes->Sigma(0, m);
-    jumps = internal::FindJumps(t, z, gaps, noise);
+    // The noise profile before the search (its jumps and glitches read as noise there too) floors
+    // the search's scale where the samples are noisier: against the recording's σ a burst's slopes
+    // were taken for jumps.
+    std::optional<internal::NoiseProfile> before;
+    if (magnitudes) before.emplace(noise, *magnitudes, m);
+    jumps = internal::FindJumps(t, z, gaps, noise, before ? &*before : nullptr);
   }
   std::vector<char> kept(static_cast<size_t>(m), 1);
   for (const Eigen::Index i : jumps.outliers) {

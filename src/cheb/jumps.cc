@@ -9,6 +9,8 @@
 #include <Eigen/LU>
 #include <Eigen/QR>
 
+#include "noise_profile.h"
+
 namespace cheval::cheb::internal {
 namespace {
 
@@ -35,7 +37,7 @@ using Point = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 4, 1>;
 class SlopeScan {
  public:
   SlopeScan(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<Eigen::Index>& gaps,
-            const Eigen::VectorXd& noise)
+            const Eigen::VectorXd& noise, const NoiseProfile* profile)
       : n_(t.size() - 1), d_(z.cols()), slopes_(std::max<Eigen::Index>(n_, 0), z.cols()), mid_(std::max<Eigen::Index>(n_, 0)),
         dt_(std::max<Eigen::Index>(n_, 0)), cut_(static_cast<size_t>(std::max<Eigen::Index>(n_, 0)), 0),
         masked_(static_cast<size_t>(std::max<Eigen::Index>(n_, 0)), 0) {
@@ -59,6 +61,21 @@ class SlopeScan {
       const double magnitude = n_ >= 0 ? z.col(c).cwiseAbs().maxCoeff() : 0.0;
       noise_floor_[c] = std::max(std::sqrt(2.0) * noise[c], 1e-9 * (1.0 + magnitude));
     }
+    // Where the noise profile is raised, its slope noise floors the scale instead, over the raised
+    // blocks and one block on either side: a burst of noise's edge half fills a block, whose own
+    // estimate then stays below it while its slopes depart by the burst's noise.
+    if (profile != nullptr && profile->raised_samples() > 0) {
+      const Eigen::Index m = t.size(), block = NoiseProfile::kBlock, blocks = (m + block - 1) / block;
+      Eigen::MatrixXd own(blocks, d_);
+      for (Eigen::Index b = 0; b < blocks; ++b) own.row(b) = profile->Over(b * block, std::min(block, m - b * block)).transpose();
+      block_floor_.resize(blocks, d_);
+      for (Eigen::Index b = 0; b < blocks; ++b) {
+        Eigen::RowVectorXd sigma = own.row(b);
+        if (b > 0) sigma = sigma.cwiseMax(own.row(b - 1));
+        if (b + 1 < blocks) sigma = sigma.cwiseMax(own.row(b + 1));
+        block_floor_.row(b) = std::sqrt(2.0) * sigma.cwiseMax(noise_floor_.transpose() / std::sqrt(2.0));
+      }
+    }
   }
 
   Eigen::Index size() const { return n_; }
@@ -66,7 +83,12 @@ class SlopeScan {
   double SampleNoise(Eigen::Index c) const { return noise_floor_[c] / std::sqrt(2.0); }
   // The local scale of slope j's departures in coordinate c (never below the slope noise).
   double LocalScale(Eigen::Index j, Eigen::Index c, const Eigen::MatrixXd& scale) const {
-    return std::max(scale(j / kBlock, c), noise_floor_[c] / dt_[j]);
+    return std::max(scale(j / kBlock, c), SlopeNoise(j, c));
+  }
+  // The slope noise of slope j in coordinate c: sqrt(2)·σ/dt, σ the profile's near it.
+  double SlopeNoise(Eigen::Index j, Eigen::Index c) const {
+    const double floor = block_floor_.size() > 0 ? block_floor_(j / NoiseProfile::kBlock, c) : noise_floor_[c];
+    return floor / dt_[j];
   }
   bool Usable(Eigen::Index j) const { return !cut_[static_cast<size_t>(j)] && !masked_[static_cast<size_t>(j)]; }
   void Cut(Eigen::Index j) { cut_[static_cast<size_t>(j)] = 1; }
@@ -181,7 +203,7 @@ class SlopeScan {
       mean /= s0;
       for (const Eigen::Index i : used) slope += (mid_[i] - mean_u) * (slopes_(i, c) - mean);
       slope = spread > 0.0 ? slope / spread : 0.0;
-      const double s = std::max(scale(at / kBlock, c), noise_floor_[c] / dt_[at]);
+      const double s = std::max(scale(at / kBlock, c), SlopeNoise(at, c));
       for (const Eigen::Index i : used) {
         const double r = (slopes_(i, c) - mean - slope * (mid_[i] - mean_u)) / s;
         cost += r * r;
@@ -224,6 +246,7 @@ class SlopeScan {
   Eigen::VectorXd mid_, dt_;
   std::vector<char> cut_, masked_;
   Eigen::VectorXd noise_floor_;
+  Eigen::MatrixXd block_floor_;  // per block of the noise profile; empty: noise_floor_ everywhere
 };
 
 // Each step again, from the samples themselves: a cubic through kStepSamples samples on either
@@ -291,10 +314,10 @@ void RefineSteps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::
 }  // namespace
 
 Jumps FindJumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<Eigen::Index>& gaps,
-                const Eigen::VectorXd& noise) {
+                const Eigen::VectorXd& noise, const NoiseProfile* profile) {
   Jumps jumps;
   if (t.size() < 2 * (kSide + kSkip) + 2) return jumps;
-  SlopeScan scan(t, z, gaps, noise);
+  SlopeScan scan(t, z, gaps, noise, profile);
   const Eigen::Index n = scan.size();
   // Strongest first: a jump's own slope outranks the neighbours it disturbs. Each candidate is
   // scored again just before it is judged (earlier findings change its neighbours' lines).

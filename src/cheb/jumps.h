@@ -25,10 +25,13 @@ struct Jumps {
   std::vector<std::pair<Eigen::Index, Eigen::VectorXd>> steps;
 };
 
+class NoiseProfile;
+
 /// t: sorted times (s), z: m x d samples, gaps: boundaries b that are already gaps (not crossed by
 /// the neighbour lines), noise: the samples' noise σ per coordinate (sets the floor of the local
-/// scale). O(m) for a fixed neighbourhood.
+/// scale), `profile` (optional): the samples' noise profile, which raises that floor where the
+/// samples are noisier (a burst's slopes are not jumps). O(m) for a fixed neighbourhood.
 Jumps FindJumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<Eigen::Index>& gaps,
-                const Eigen::VectorXd& noise);
+                const Eigen::VectorXd& noise, const NoiseProfile* profile = nullptr);
 
 }  // namespace cheval::cheb::internal
