@@ -22,17 +22,27 @@ NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitu
     }
     return false;
   };
+  const Eigen::Index blocks = (m + kBlock - 1) / kBlock;
+  Eigen::MatrixXd bursts = Eigen::MatrixXd::Zero(blocks, d);
+  for (Eigen::Index b = 0; b < blocks; ++b) {
+    const Eigen::Index begin = b * kBlock, end = std::min(m, begin + kBlock);
+    if (!may_exceed(burst_counts, begin, end)) continue;
+    const Eigen::VectorXd own = magnitudes.SigmaIfAbove(begin, end, burst);
+    for (Eigen::Index c = 0; c < d; ++c) {
+      if (own[c] > burst[c]) bursts(b, c) = own[c];
+    }
+  }
   for (Eigen::Index begin = 0; begin < m; begin += kBlock) {
     const Eigen::Index end = std::min(m, begin + kBlock);
     const Eigen::Index from = std::max<Eigen::Index>(0, begin - kPooledBlocks * kBlock);
     const Eigen::Index to = std::min(m, end + kPooledBlocks * kBlock);
     Eigen::VectorXd local = may_exceed(counts, from, to) ? magnitudes.SigmaIfAbove(from, to, raise) : level;
-    // A burst shorter than half the pool leaves its median; the block's own estimate shows it.
-    if (may_exceed(burst_counts, begin, end)) {
-      const Eigen::VectorXd own = magnitudes.SigmaIfAbove(begin, end, burst);
-      for (Eigen::Index c = 0; c < d; ++c) {
-        if (own[c] > burst[c]) local[c] = std::max(local[c], own[c]);
-      }
+    // A burst shorter than half the pool leaves its median; the block's own estimate shows it,
+    // and the blocks beside it take it too (a burst's edge half fills its block, whose own
+    // estimate may stay below the threshold while its windows fit the burst's noise).
+    const Eigen::Index b = begin / kBlock;
+    for (Eigen::Index k = std::max<Eigen::Index>(0, b - 1); k <= std::min(blocks - 1, b + 1); ++k) {
+      local = local.cwiseMax(bursts.row(k).transpose());
     }
     Eigen::RowVectorXd variance = level.cwiseAbs2().transpose();
     bool raised = false;

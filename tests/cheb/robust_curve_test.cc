@@ -220,7 +220,7 @@ TEST(Jumps, NothingIsFoundNearTheEndsOfCleanNoisyData) {
 // them, so the jump search took their slopes for jumps against the recording's noise (up to 25 of
 // them, cutting segments of 4–15 samples fitted at degrees up to 10) and the windows fitted their
 // noise: 1.7–4.2x central differences' error inside the bursts, up to 5.7 m/s off. Now the profile
-// is raised over them and floors the jump search's scale there.
+// is raised over them and the blocks beside them, and floors the jump search's scale there.
 TEST(Jumps, NoiseBurstsAreNeitherJumpsNorMotion) {
   constexpr double kRate = 300.0, kNoise = 5e-5, kBurstNoise = 3e-4;
   constexpr Eigen::Index kBurst = 60;
@@ -248,10 +248,10 @@ TEST(Jumps, NoiseBurstsAreNeitherJumpsNorMotion) {
       largest = std::max(largest, e), largest_central = std::max(largest_central, ec);
       if (burst[static_cast<size_t>(i)]) fit += e * e, central += ec * ec;
     }
-    // Inside the bursts, where noise dominates, no worse than central differences; nowhere a
-    // velocity off by far more than theirs.
-    EXPECT_LT(fit, central) << "seed " << seed;
-    EXPECT_LT(largest, 2.0 * largest_central) << "seed " << seed;
+    // Inside the bursts, where noise dominates, at most 0.2x central differences' error (issue 14's
+    // target there); nowhere a velocity off by more than theirs.
+    EXPECT_LT(std::sqrt(fit / central), 0.2) << "seed " << seed;
+    EXPECT_LT(largest, largest_central) << "seed " << seed;
   }
 }
 
