@@ -61,19 +61,14 @@ class SlopeScan {
       const double magnitude = n_ >= 0 ? z.col(c).cwiseAbs().maxCoeff() : 0.0;
       noise_floor_[c] = std::max(std::sqrt(2.0) * noise[c], 1e-9 * (1.0 + magnitude));
     }
-    // Where the noise profile is raised, its slope noise floors the scale instead, over the raised
-    // blocks and one block on either side: a burst of noise's edge half fills a block, whose own
-    // estimate then stays below it while its slopes depart by the burst's noise.
+    // Where the noise profile is raised (over a burst, the blocks beside it too), its slope noise
+    // floors the scale instead.
     if (profile != nullptr && profile->raised_samples() > 0) {
       const Eigen::Index m = t.size(), block = NoiseProfile::kBlock, blocks = (m + block - 1) / block;
-      Eigen::MatrixXd own(blocks, d_);
-      for (Eigen::Index b = 0; b < blocks; ++b) own.row(b) = profile->Over(b * block, std::min(block, m - b * block)).transpose();
       block_floor_.resize(blocks, d_);
       for (Eigen::Index b = 0; b < blocks; ++b) {
-        Eigen::RowVectorXd sigma = own.row(b);
-        if (b > 0) sigma = sigma.cwiseMax(own.row(b - 1));
-        if (b + 1 < blocks) sigma = sigma.cwiseMax(own.row(b + 1));
-        block_floor_.row(b) = std::sqrt(2.0) * sigma.cwiseMax(noise_floor_.transpose() / std::sqrt(2.0));
+        const Eigen::VectorXd sigma = profile->Over(b * block, std::min(block, m - b * block));
+        block_floor_.row(b) = (std::sqrt(2.0) * sigma).cwiseMax(noise_floor_).transpose();
       }
     }
   }
