@@ -908,14 +908,14 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   internal::Jumps jumps;
   Eigen::VectorXd noise;  // of the samples split at the gaps
   std::optional<internal::DifferenceMagnitudes> magnitudes;  // of the samples fitted, for their noise profile
+  // The noise profile before the search (its jumps and glitches read as noise there too) floors
+  // the search's scale where the samples are noisier: against the recording's σ a burst's slopes
+  // were taken for jumps. Where the search finds nothing, it is the fit's profile as well.
+  std::optional<internal::NoiseProfile> before;
   if (options.robust) {
     if (!options.noise_sigma) magnitudes.emplace(t, z, gaps);
     noise = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
                                 : magnitudes->Sigma(0, m);
-    // The noise profile before the search (its jumps and glitches read as noise there too) floors
-    // the search's scale where the samples are noisier: against the recording's σ a burst's slopes
-    // were taken for jumps.
-    std::optional<internal::NoiseProfile> before;
     if (magnitudes) before.emplace(noise, *magnitudes, m);
     jumps = internal::FindJumps(t, z, gaps, noise, before ? &*before : nullptr);
   }
@@ -985,8 +985,11 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
                                                     : magnitudes->Sigma(0, fitted_count);
   // A noise σ given is taken everywhere; an estimated one is raised over stretches that are clearly
   // noisier than the data as a whole.
-  const internal::NoiseProfile profile = magnitudes ? internal::NoiseProfile(curve.noise_sigma_, *magnitudes, fitted_count)
-                                                    : internal::NoiseProfile(curve.noise_sigma_);
+  const internal::NoiseProfile profile =
+      before && !found ? std::move(*before)
+      : magnitudes     ? internal::NoiseProfile(curve.noise_sigma_, *magnitudes, fitted_count)
+                       : internal::NoiseProfile(curve.noise_sigma_);
+  before.reset();
   magnitudes.reset();
   curve.noisier_samples_ = profile.raised_samples();
   if (curve.noisier_samples_ > 0) curve.noise_sigma_max_ = profile.maximum();
