@@ -6,11 +6,13 @@
 #include "local_rates.h"
 #include "local_regression.h"
 #include "noise_profile.h"
+#include "work_queue.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <numbers>
 #include <numeric>
 #include <tuple>
@@ -49,6 +51,12 @@ constexpr double kHeldOutFloor = 1e-12;
 // An end step (from the interval's end to the second sample from it) of more than this many mean
 // steps is a hole at the end of a window, which lowers its top degree (WindowFitter::TopDegree).
 constexpr double kEndHoleRatio = 2.5;
+// A fit of at least this many samples takes CurveOptions::threads threads where its work splits
+// into independent parts; below, one (starting a thread costs about as much as fitting a few
+// hundred samples).
+constexpr Eigen::Index kParallelSamples = 2000;
+// Curve::EvaluateMany splits at least this many queries over the curve's threads.
+constexpr Eigen::Index kParallelQueries = 8192;
 // End windows are halved (RefineEnds) while they keep this many samples on each side.
 constexpr Eigen::Index kMinEndWindowSamples = 24;
 using internal::kMaxGramCondition;
@@ -677,83 +685,90 @@ Eigen::Index EndWindowMinimum(const CurveOptions& options) {
   return 2 * std::max<Eigen::Index>(options.min_window_samples, kMinEndWindowSamples);
 }
 
-// Fits cores [a, b] of a segment adaptively: a core is halved until its series resolves or it
-// gets too small to split. Windows come out in time order.
+// A core [a, b] of segment `segment` to fit adaptively (FitCore): whether it is a piece of a
+// window split for missed motion, whether it is the end window RefineEnds would cut (below) and,
+// when SplitPredictsBetter fitted it already, that fit.
+struct Core {
+  size_t segment = 0;
+  double a = 0, b = 0;
+  bool piece = false, end_piece = false;
+  std::optional<HalfFit> fitted = std::nullopt;
+};
+
+// Fits a core of `segment` adaptively: returns its window when it is accepted, else pushes the two
+// halves it is cut into (the right one first, so that the left is taken first from a stack). A
+// core is halved until its series resolves or it gets too small to split; each core depends on
+// nothing but its own fields, so cores may be fitted in any order.
+template <typename Push>
+std::optional<CurveWindow> FitCore(const WindowFitter& fitter, const Eigen::VectorXd& t, const CurveSegment& segment,
+                                   const CurveOptions& options, Core core, Push&& push) {
+  const double a = core.a, b = core.b;
+  const bool end_piece = core.end_piece;
+  std::optional<HalfFit>& fitted = core.fitted;
+  auto cut = [&](bool left_end, bool right_end, bool pieces, std::array<std::optional<HalfFit>, 2> halves) {
+    const double middle = 0.5 * (a + b);
+    push(Core{core.segment, middle, b, pieces, right_end, std::move(halves[1])});
+    push(Core{core.segment, a, middle, pieces, left_end, std::move(halves[0])});
+  };
+  const Eigen::Index inside = SamplesIn(t, a, b);
+  const bool may_split = inside >= 2 * options.min_window_samples;
+  // A window at an end of its segment whose degree exceeds end_degree is cut by RefineEnds when
+  // it is accepted and split when it is not. When that degree is certain, it is cut here unfitted,
+  // as RefineEnds would: the outer half is the end window to refine further (fitted without
+  // splitting, halved again while its degree exceeds end_degree), the inner half an ordinary core.
+  // A whole segment is cut at its front first, like RefineEnds does.
+  const bool front = a == segment.begin, back = b == segment.end;
+  const bool refine_ends = options.end_degree > 0 && options.degree_method == DegreeMethod::kCrossValidation;
+  const bool refinable = refine_ends && (front || back) && inside >= EndWindowMinimum(options);
+  if (refinable && !fitted &&
+      fitter.DegreeCertainlyAbove(a, b, segment.begin, segment.end, options.end_degree) &&
+      (end_piece || fitter.ResolvedAtTop(a, b, segment.begin, segment.end))) {
+    cut(front, back && !front, false, {});
+    return std::nullopt;
+  }
+  Eigen::VectorXd held_out;
+  bool undecided = false, missed = false;
+  std::optional<CurveWindow> window;
+  if (end_piece) {
+    window = fitter.Fit(a, b, segment.begin, segment.end, false);
+    if (refinable && MaxDegree(*window) > options.end_degree) {
+      cut(front, !front, false, {});
+      return std::nullopt;
+    }
+  } else if (fitted && (!may_split || fitted->reusable)) {
+    // The fit SplitPredictsBetter made without splitting is this one when splitting is not
+    // allowed here either, or when it says the same call with splitting would return it.
+    window = std::move(fitted->window);
+    held_out = std::move(fitted->held_out);
+  } else {
+    window = fitter.Fit(a, b, segment.begin, segment.end, may_split, &held_out, &undecided, &missed);
+  }
+  std::array<std::optional<HalfFit>, 2> halves;
+  if (window && may_split && !end_piece &&
+      SplitPredictsBetter(fitter, *window, held_out, segment, options, undecided, &halves)) {
+    // Missed motion when its residual said so; a window split because its coefficients could
+    // not show it resolved (undecided) is only too long for its top degree.
+    missed = window->lack_of_fit.maxCoeff() > kSplitScore;
+    window.reset();
+  }
+  if (!window) {
+    cut(false, false, core.piece || missed, std::move(halves));
+    return std::nullopt;
+  }
+  window->missed_motion = core.piece;
+  return window;
+}
+
+// Fits cores [a0, b0] of a segment adaptively (FitCore), on the caller's thread. Windows come out
+// in time order.
 std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::VectorXd& t, const CurveSegment& segment,
                                      double a0, double b0, const CurveOptions& options) {
   std::vector<CurveWindow> windows;
-  // A core to fit: whether it is a piece of a window split for missed motion, whether it is the
-  // end window RefineEnds would cut (below) and, when SplitPredictsBetter fitted it already, that fit.
-  struct Core {
-    double a, b;
-    bool piece = false, end_piece = false;
-    std::optional<HalfFit> fitted = std::nullopt;
-  };
-  std::vector<Core> stack;
-  stack.push_back({a0, b0});
-  const Eigen::Index end_minimum = EndWindowMinimum(options);
-  const bool refine_ends = options.end_degree > 0 && options.degree_method == DegreeMethod::kCrossValidation;
-  while (!stack.empty()) {
-    auto [a, b, piece, end_piece, fitted] = std::move(stack.back());
-    stack.pop_back();
-    const Eigen::Index inside = SamplesIn(t, a, b);
-    const bool may_split = inside >= 2 * options.min_window_samples;
-    // A window at an end of its segment whose degree exceeds end_degree is cut by RefineEnds when
-    // it is accepted and split when it is not. When that degree is certain, it is cut here unfitted,
-    // as RefineEnds would: the outer half is the end window to refine further (fitted without
-    // splitting, halved again while its degree exceeds end_degree), the inner half an ordinary core.
-    // A whole segment is cut at its front first, like RefineEnds does.
-    const bool front = a == segment.begin, back = b == segment.end;
-    const bool refinable = refine_ends && (front || back) && inside >= end_minimum;
-    if (refinable && !fitted &&
-        fitter.DegreeCertainlyAbove(a, b, segment.begin, segment.end, options.end_degree) &&
-        (end_piece || fitter.ResolvedAtTop(a, b, segment.begin, segment.end))) {
-      const double middle = 0.5 * (a + b);
-      stack.push_back({middle, b, false, back && !front});
-      stack.push_back({a, middle, false, front});
-      continue;
+  internal::DrainWork(std::vector<Core>{Core{0, a0, b0}}, 1, [&](Core core, auto&& push) {
+    if (std::optional<CurveWindow> window = FitCore(fitter, t, segment, options, std::move(core), push)) {
+      windows.push_back(std::move(*window));
     }
-    Eigen::VectorXd held_out;
-    bool undecided = false, missed = false;
-    std::optional<CurveWindow> window;
-    if (end_piece) {
-      window = fitter.Fit(a, b, segment.begin, segment.end, false);
-      if (refinable && MaxDegree(*window) > options.end_degree) {
-        const double middle = 0.5 * (a + b);
-        stack.push_back({middle, b, false, !front});
-        stack.push_back({a, middle, false, front});
-        continue;
-      }
-    } else if (fitted && (!may_split || fitted->reusable)) {
-      // The fit SplitPredictsBetter made without splitting is this one when splitting is not
-      // allowed here either, or when it says the same call with splitting would return it.
-      window = std::move(fitted->window);
-      held_out = std::move(fitted->held_out);
-    } else {
-      window = fitter.Fit(a, b, segment.begin, segment.end, may_split, &held_out, &undecided, &missed);
-    }
-    std::array<std::optional<HalfFit>, 2> halves;
-    if (window && may_split && !end_piece &&
-        SplitPredictsBetter(fitter, *window, held_out, segment, options, undecided, &halves)) {
-      // Missed motion when its residual said so; a window split because its coefficients could
-      // not show it resolved (undecided) is only too long for its top degree.
-      missed = window->lack_of_fit.maxCoeff() > kSplitScore;
-      window.reset();
-    }
-    if (!window) {
-      const double middle = 0.5 * (a + b);
-      // The left half is popped first: windows stay in time order.
-      stack.push_back({middle, b, piece || missed, false, std::move(halves[1])});
-      stack.push_back({a, middle, piece || missed, false, std::move(halves[0])});
-      continue;
-    }
-    window->missed_motion = piece;
-    windows.push_back(std::move(*window));
-    if (options.progress) {  // the samples up to this window's end are fitted (windows come in time order)
-      const auto done = std::upper_bound(t.data(), t.data() + t.size(), b) - t.data();
-      options.progress("fitting windows", done, t.size());
-    }
-  }
+  });
   return windows;
 }
 
@@ -868,6 +883,7 @@ void CurveOptions::Validate() const {
   check(!noise_sigma || (*noise_sigma >= 0.0 && std::isfinite(*noise_sigma)), "noise_sigma",
         "must be a non-negative number, got {}", noise_sigma.value_or(0.0));
   check(end_degree >= 0, "end_degree", "must be non-negative (0: no end refinement), got {}", end_degree);
+  check(threads >= 0, "threads", "must be non-negative (0: every core), got {}", threads);
 }
 
 Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen::MatrixXd>& values,
@@ -877,12 +893,16 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   if (values.rows() != m) throw std::invalid_argument("FitCurve: stamps and values differ in length");
   if (values.cols() < 1 || values.cols() > 4) throw std::invalid_argument("FitCurve: 1..4 coordinates");
   if (m < 2) throw ComputeError(fmt::format("a fit needs at least 2 samples, got {}", m));
+  const int threads = m >= kParallelSamples ? internal::ThreadCount(options.threads) : 1;
 
   std::vector<Eigen::Index> order(m);
   std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](Eigen::Index i, Eigen::Index j) { return stamps_ns[i] < stamps_ns[j]; });
+  if (!std::is_sorted(stamps_ns.begin(), stamps_ns.end())) {
+    std::stable_sort(order.begin(), order.end(), [&](Eigen::Index i, Eigen::Index j) { return stamps_ns[i] < stamps_ns[j]; });
+  }
   Curve curve;
   curve.origin_ns_ = stamps_ns[order.front()];
+  curve.threads_ = options.threads;
   curve.dimension_ = static_cast<int>(values.cols());
   Eigen::VectorXd t(m);
   Eigen::MatrixXd z(m, values.cols());
@@ -896,8 +916,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   for (Eigen::Index i = 1; i < m; ++i) {
     if (t[i] > t[i - 1]) dts.push_back(t[i] - t[i - 1]);
   }
-  std::nth_element(dts.begin(), dts.begin() + static_cast<std::ptrdiff_t>(dts.size() / 2), dts.end());
-  const double gap = std::max(options.gap_factor * dts[dts.size() / 2], options.min_gap_s);
+  const double gap = std::max(options.gap_factor * internal::SelectNonNegative(&dts, dts.size() / 2), options.min_gap_s);
   // Boundaries b (between sorted samples b and b + 1) where the data are split.
   std::vector<Eigen::Index> gaps;
   for (Eigen::Index i = 1; i < m; ++i) {
@@ -913,11 +932,11 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   // were taken for jumps. Where the search finds nothing, it is the fit's profile as well.
   std::optional<internal::NoiseProfile> before;
   if (options.robust) {
-    if (!options.noise_sigma) magnitudes.emplace(t, z, gaps);
+    if (!options.noise_sigma) magnitudes.emplace(t, z, gaps, threads);
     noise = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
                                 : magnitudes->Sigma(0, m);
     if (magnitudes) before.emplace(noise, *magnitudes, m);
-    jumps = internal::FindJumps(t, z, gaps, noise, before ? &*before : nullptr);
+    jumps = internal::FindJumps(t, z, gaps, noise, before ? &*before : nullptr, threads);
   }
   std::vector<char> kept(static_cast<size_t>(m), 1);
   for (const Eigen::Index i : jumps.outliers) {
@@ -979,7 +998,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
 
   // Taken again where the search found something (fewer samples, steps out, more cuts).
   const bool found = !jumps.outliers.empty() || !jumps.steps.empty() || !jumps.breaks.empty();
-  if (!options.noise_sigma && (found || !magnitudes)) magnitudes.emplace(t, z, cuts);
+  if (!options.noise_sigma && (found || !magnitudes)) magnitudes.emplace(t, z, cuts, threads);
   curve.noise_sigma_ = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
                        : noise.size() > 0 && !found ? noise
                                                     : magnitudes->Sigma(0, fitted_count);
@@ -1022,24 +1041,47 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
 
   ReportProgress(options.progress, "fitting windows", 0, fitted_count);
   for (size_t k = 0; k + 1 < starts.size(); ++k) {
-    CurveSegment segment;
+    CurveSegment& segment = curve.segments_.emplace_back();
     segment.begin = t[starts[k]];
     segment.end = t[starts[k + 1] - 1];
     segment.continues = at_jump[k] != 0;
-    if (options.single_window || options.window_s) {
-      const int cores = options.single_window
-                            ? 1
-                            : std::max(1, static_cast<int>(std::lround((segment.end - segment.begin) / *options.window_s)));
-      for (int c = 0; c < cores; ++c) {
-        const double a = segment.begin + (segment.end - segment.begin) * c / cores;
-        const double b = c + 1 == cores ? segment.end : segment.begin + (segment.end - segment.begin) * (c + 1) / cores;
-        segment.windows.push_back(*fitter.Fit(a, b, segment.begin, segment.end, false));
-      }
-    } else {
-      segment.windows = FitAdaptive(fitter, t, segment, segment.begin, segment.end, options);
+    if (!options.single_window && !options.window_s) continue;
+    const int cores = options.single_window
+                          ? 1
+                          : std::max(1, static_cast<int>(std::lround((segment.end - segment.begin) / *options.window_s)));
+    for (int c = 0; c < cores; ++c) {
+      const double a = segment.begin + (segment.end - segment.begin) * c / cores;
+      const double b = c + 1 == cores ? segment.end : segment.begin + (segment.end - segment.begin) * (c + 1) / cores;
+      segment.windows.push_back(*fitter.Fit(a, b, segment.begin, segment.end, false));
+    }
+  }
+  if (!options.single_window && !options.window_s) {
+    // The cores of all segments are fitted on the threads; each thread's windows wait under the
+    // lock in their segment and are put in time order once all are fitted.
+    std::vector<Core> roots;
+    for (size_t k = curve.segments_.size(); k-- > 0;) {  // the first segment on top of the stack
+      roots.push_back(Core{k, curve.segments_[k].begin, curve.segments_[k].end});
+    }
+    std::vector<std::vector<CurveWindow>> windows(curve.segments_.size());
+    std::mutex windows_mutex;
+    Eigen::Index done = 0;
+    internal::DrainWork(std::move(roots), threads, [&](Core core, auto&& push) {
+      const size_t k = core.segment;
+      const Eigen::Index inside = SamplesIn(t, core.a, core.b);
+      std::optional<CurveWindow> window = FitCore(fitter, t, curve.segments_[k], options, std::move(core), push);
+      if (!window) return;
+      const std::lock_guard<std::mutex> lock(windows_mutex);
+      windows[k].push_back(std::move(*window));
+      done = std::min(fitted_count, done + inside);
+      ReportProgress(options.progress, "fitting windows", done, fitted_count);
+    });
+    for (size_t k = 0; k < windows.size(); ++k) {
+      CurveSegment& segment = curve.segments_[k];
+      segment.windows = std::move(windows[k]);
+      std::sort(segment.windows.begin(), segment.windows.end(),
+                [](const CurveWindow& x, const CurveWindow& y) { return x.core_begin < y.core_begin; });
       RefineEnds(fitter, t, segment, options);
     }
-    curve.segments_.push_back(std::move(segment));
   }
 
   const bool adaptive = !options.single_window && !options.window_s && options.degree_method != DegreeMethod::kFixed;
@@ -1059,7 +1101,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     };
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
       const bool front_at_jump = k > 0 && curve.segments_[k - 1].continues;
-      internal::AddEndCaps(t, z, velocity, starts[k], starts[k + 1], front_at_jump, &curve.segments_[k]);
+      internal::AddEndCaps(t, z, velocity, starts[k], starts[k + 1], front_at_jump, &curve.segments_[k], threads);
     }
   }
 
@@ -1282,75 +1324,83 @@ void Curve::EvaluateMany(std::span<const int64_t> stamps_ns, int order, Eigen::M
   if (!std::is_sorted(stamps_ns.begin(), stamps_ns.end())) {
     std::stable_sort(sorted.begin(), sorted.end(), [&](Eigen::Index i, Eigen::Index j) { return stamps_ns[i] < stamps_ns[j]; });
   }
-  std::vector<double> t(static_cast<size_t>(n));
-  std::vector<Placement> placements(static_cast<size_t>(n));
-  // A query inside a local run is the run's (no window is evaluated for it).
-  std::vector<const LocalRun*> local(static_cast<size_t>(n));
-  for (Eigen::Index r = 0; r < n; ++r) {
-    t[r] = static_cast<double>(stamps_ns[sorted[r]] - origin_ns_) * 1e-9;
-    local[r] = LocalRunAt(t[r]);
-    if (local[r] == nullptr) placements[r] = Locate(t[r], tolerance_s);
-  }
-  // Each window evaluated at a run of queries at once (vectorised Clenshaw), for the left and the
-  // right window of every query: (order + 1) blocks of n x d each.
   const Eigen::Index d = dimension_;
-  std::array<Eigen::MatrixXd, 3> left, right;
-  for (int k = 0; k <= order; ++k) {
-    left[k].resize(n, d);
-    right[k].resize(n, d);
-  }
-  auto evaluate_runs = [&](bool use_right, std::array<Eigen::MatrixXd, 3>& out) {
-    for (Eigen::Index begin = 0; begin < n;) {
-      const CurveWindow* w = use_right ? placements[begin].right : placements[begin].left;
-      Eigen::Index end = begin + 1;
-      while (end < n && (use_right ? placements[end].right : placements[end].left) == w) ++end;
-      if (w != nullptr) {
-        Eigen::VectorXd x(end - begin);
-        for (Eigen::Index r = begin; r < end; ++r) x[r - begin] = w->series.interval.ToUnit(t[r]);
-        const double scale = w->series.interval.DerivativeScale();
-        out[0].middleRows(begin, end - begin) = EvaluateSeries(w->series.coefficients, x);
-        if (order >= 1) out[1].middleRows(begin, end - begin) = EvaluateSeries(w->first_derivative, x) * scale;
-        if (order >= 2) {
-          out[2].middleRows(begin, end - begin) = EvaluateSeries(w->second_derivative, x) * (scale * scale);
-        }
-      }
-      begin = end;
-    }
-  };
-  evaluate_runs(false, left);
-  evaluate_runs(true, right);
   values->resize(n, d);
   if (order >= 1) first->resize(n, d);
   if (order >= 2) second->resize(n, d);
-  for (Eigen::Index r = 0; r < n; ++r) {
-    const Placement& q = placements[r];
-    const Eigen::Index i = sorted[r];
-    if (local[r] != nullptr) {
-      Eigen::RowVectorXd p(d), v(d), a(d);
-      EvaluateLocal(*local[r], t[r], order, p, v, a);
-      values->row(i) = p;
+  // The queries sorted[r0..r1) (each writes its own rows only).
+  auto evaluate = [&](Eigen::Index r0, Eigen::Index r1) {
+    const Eigen::Index count = r1 - r0;
+    std::vector<double> t(static_cast<size_t>(count));
+    std::vector<Placement> placements(static_cast<size_t>(count));
+    // A query inside a local run is the run's (no window is evaluated for it).
+    std::vector<const LocalRun*> local(static_cast<size_t>(count));
+    for (Eigen::Index r = 0; r < count; ++r) {
+      t[r] = static_cast<double>(stamps_ns[sorted[r0 + r]] - origin_ns_) * 1e-9;
+      local[r] = LocalRunAt(t[r]);
+      if (local[r] == nullptr) placements[r] = Locate(t[r], tolerance_s);
+    }
+    // Each window evaluated at a run of queries at once (vectorised Clenshaw), for the left and
+    // the right window of every query: (order + 1) blocks of count x d each.
+    std::array<Eigen::MatrixXd, 3> left, right;
+    for (int k = 0; k <= order; ++k) {
+      left[k].resize(count, d);
+      right[k].resize(count, d);
+    }
+    auto evaluate_runs = [&](bool use_right, std::array<Eigen::MatrixXd, 3>& out) {
+      for (Eigen::Index begin = 0; begin < count;) {
+        const CurveWindow* w = use_right ? placements[begin].right : placements[begin].left;
+        Eigen::Index end = begin + 1;
+        while (end < count && (use_right ? placements[end].right : placements[end].left) == w) ++end;
+        if (w != nullptr) {
+          Eigen::VectorXd x(end - begin);
+          for (Eigen::Index r = begin; r < end; ++r) x[r - begin] = w->series.interval.ToUnit(t[r]);
+          const double scale = w->series.interval.DerivativeScale();
+          out[0].middleRows(begin, end - begin) = EvaluateSeries(w->series.coefficients, x);
+          if (order >= 1) out[1].middleRows(begin, end - begin) = EvaluateSeries(w->first_derivative, x) * scale;
+          if (order >= 2) {
+            out[2].middleRows(begin, end - begin) = EvaluateSeries(w->second_derivative, x) * (scale * scale);
+          }
+        }
+        begin = end;
+      }
+    };
+    evaluate_runs(false, left);
+    evaluate_runs(true, right);
+    for (Eigen::Index r = 0; r < count; ++r) {
+      const Placement& q = placements[r];
+      const Eigen::Index i = sorted[r0 + r];
+      if (local[r] != nullptr) {
+        Eigen::RowVectorXd p(d), v(d), a(d);
+        EvaluateLocal(*local[r], t[r], order, p, v, a);
+        values->row(i) = p;
+        AddSteps(t[r], values->row(i));
+        if (order >= 1) first->row(i) = v;
+        if (order >= 2) second->row(i) = a;
+        continue;
+      }
+      if (q.right == nullptr) {
+        values->row(i) = left[0].row(r);
+        AddSteps(t[r], values->row(i));
+        if (order >= 1) first->row(i) = left[1].row(r);
+        if (order >= 2) second->row(i) = left[2].row(r);
+        continue;
+      }
+      const double s = q.s, ds = q.ds, dds = q.dds;
+      const auto dp = right[0].row(r) - left[0].row(r);
+      values->row(i) = (1.0 - s) * left[0].row(r) + s * right[0].row(r);
       AddSteps(t[r], values->row(i));
-      if (order >= 1) first->row(i) = v;
-      if (order >= 2) second->row(i) = a;
-      continue;
+      if (order >= 1) first->row(i) = (1.0 - s) * left[1].row(r) + s * right[1].row(r) + ds * dp;
+      if (order >= 2) {
+        second->row(i) = (1.0 - s) * left[2].row(r) + s * right[2].row(r) +
+                         2.0 * ds * (right[1].row(r) - left[1].row(r)) + dds * dp;
+      }
     }
-    if (q.right == nullptr) {
-      values->row(i) = left[0].row(r);
-      AddSteps(t[r], values->row(i));
-      if (order >= 1) first->row(i) = left[1].row(r);
-      if (order >= 2) second->row(i) = left[2].row(r);
-      continue;
-    }
-    const double s = q.s, ds = q.ds, dds = q.dds;
-    const auto dp = right[0].row(r) - left[0].row(r);
-    values->row(i) = (1.0 - s) * left[0].row(r) + s * right[0].row(r);
-    AddSteps(t[r], values->row(i));
-    if (order >= 1) first->row(i) = (1.0 - s) * left[1].row(r) + s * right[1].row(r) + ds * dp;
-    if (order >= 2) {
-      second->row(i) = (1.0 - s) * left[2].row(r) + s * right[2].row(r) +
-                       2.0 * ds * (right[1].row(r) - left[1].row(r)) + dds * dp;
-    }
-  }
+  };
+  // Many queries are split into one contiguous part per thread: each query's numbers are the same
+  // however they are split.
+  const int parts = n >= kParallelQueries ? internal::ThreadCount(threads_) : 1;
+  internal::ParallelFor(parts, parts, [&](int part) { evaluate(n * part / parts, n * (part + 1) / parts); });
 }
 
 Curve Curve::FromParts(int64_t origin_ns, std::vector<CurveSegment> segments, Eigen::VectorXd noise_sigma,

@@ -1,4 +1,5 @@
 #include "end_caps.h"
+#include "work_queue.h"
 
 #include <algorithm>
 #include <array>
@@ -291,7 +292,7 @@ CurveWindow BuildCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::
 }  // namespace
 
 void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const VelocityAt& velocity, Eigen::Index first,
-                Eigen::Index last, bool front_at_jump, CurveSegment* segment) {
+                Eigen::Index last, bool front_at_jump, CurveSegment* segment, int threads) {
   std::vector<CurveWindow>& windows = segment->windows;
   if (windows.size() < 3) return;
   const double* begin = t.data() + first;
@@ -304,14 +305,15 @@ void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloci
   const Eigen::Index hi = std::lower_bound(begin, end, windows.back().fit_begin) - t.data();
   if (hi <= lo) return;
   std::array<Choice, 2> choices;
-  for (const bool front : {true, false}) {
+  ParallelFor(2, threads, [&](int side) {
+    const bool front = side == 0;
     const CurveWindow& w = front ? windows.front() : windows.back();
     const Eigen::Index end_samples = samples_in(w.fit_begin, w.fit_end);
     const Eigen::Index core_samples = samples_in(w.core_begin, w.core_end);
     const bool at_jump = front ? front_at_jump : segment->continues;
-    choices[front ? 0 : 1] =
+    choices[static_cast<size_t>(side)] =
         ChooseCap(t, z, velocity, lo, hi, last - first, w, end_samples, core_samples, at_jump ? kLongCap : 0);
-  }
+  });
   // The back first, so that inserting at the front leaves nothing to re-find.
   for (const bool front : {false, true}) {
     const Choice& choice = choices[front ? 0 : 1];

@@ -31,8 +31,9 @@ using VelocityAt = std::function<Eigen::MatrixXd(Eigen::Index first, Eigen::Inde
 /// samples; `front_at_jump` says the segment starts at a jump (its end at one: `continues`), where
 /// no cap shorter than 16 samples is tried. The cap becomes the segment's first (or last) window;
 /// the neighbouring end window's core is shortened to make room. Segments too short for artificial ends (fewer than three
-/// windows, or an interior shorter than the windows) are left as they are.
+/// windows, or an interior shorter than the windows) are left as they are. The two ends' caps are
+/// chosen on up to `threads` threads (`velocity` is then called concurrently).
 void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const VelocityAt& velocity, Eigen::Index first,
-                Eigen::Index last, bool front_at_jump, CurveSegment* segment);
+                Eigen::Index last, bool front_at_jump, CurveSegment* segment, int threads = 1);
 
 }  // namespace cheval::cheb::internal

@@ -1,4 +1,5 @@
 #include "jumps.h"
+#include "work_queue.h"
 
 #include <algorithm>
 #include <cmath>
@@ -104,12 +105,15 @@ class SlopeScan {
 
   // Every slope's departure (rows; NaN where it cannot be told or the slope is not usable), as
   // Departure gives them now: one pass serves the local scale and the first scores.
-  Eigen::MatrixXd Departures() const {
+  // On up to `threads` threads, each taking a contiguous part.
+  Eigen::MatrixXd Departures(int threads) const {
     Eigen::MatrixXd departures = Eigen::MatrixXd::Constant(n_, d_, std::numeric_limits<double>::quiet_NaN());
-    for (Eigen::Index j = 0; j < n_; ++j) {
-      if (!Usable(j)) continue;
-      if (const std::optional<Point> e = Departure(j)) departures.row(j) = e->transpose();
-    }
+    ParallelFor(threads, threads, [&](int part) {
+      for (Eigen::Index j = n_ * part / threads; j < n_ * (part + 1) / threads; ++j) {
+        if (!Usable(j)) continue;
+        if (const std::optional<Point> e = Departure(j)) departures.row(j) = e->transpose();
+      }
+    });
     return departures;
   }
 
@@ -132,24 +136,27 @@ class SlopeScan {
 
   // The local scale per block of slopes and coordinate: 1.4826 · median |departure| over the block
   // and its two neighbours' medians (the largest), from the pass's departures (Departures).
-  Eigen::MatrixXd Scales(const Eigen::MatrixXd& departures) const {
+  // The medians on up to `threads` threads, each taking a contiguous part of the blocks.
+  Eigen::MatrixXd Scales(const Eigen::MatrixXd& departures, int threads) const {
     const Eigen::Index blocks = (n_ + kBlock - 1) / kBlock;
     Eigen::MatrixXd median = Eigen::MatrixXd::Zero(blocks, d_);
-    std::vector<std::vector<double>> values(static_cast<size_t>(d_));
-    for (Eigen::Index b = 0; b < blocks; ++b) {
-      for (auto& v : values) v.clear();
-      for (Eigen::Index j = b * kBlock; j < std::min(n_, (b + 1) * kBlock); ++j) {
-        if (std::isnan(departures(j, 0))) continue;
-        for (Eigen::Index c = 0; c < d_; ++c) values[static_cast<size_t>(c)].push_back(std::abs(departures(j, c)));
+    ParallelFor(threads, threads, [&](int part) {
+      std::vector<std::vector<double>> values(static_cast<size_t>(d_));
+      for (Eigen::Index b = blocks * part / threads; b < blocks * (part + 1) / threads; ++b) {
+        for (auto& v : values) v.clear();
+        for (Eigen::Index j = b * kBlock; j < std::min(n_, (b + 1) * kBlock); ++j) {
+          if (std::isnan(departures(j, 0))) continue;
+          for (Eigen::Index c = 0; c < d_; ++c) values[static_cast<size_t>(c)].push_back(std::abs(departures(j, c)));
+        }
+        for (Eigen::Index c = 0; c < d_; ++c) {
+          std::vector<double>& v = values[static_cast<size_t>(c)];
+          if (v.empty()) continue;
+          auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+          std::nth_element(v.begin(), middle, v.end());
+          median(b, c) = 1.4826 * *middle;
+        }
       }
-      for (Eigen::Index c = 0; c < d_; ++c) {
-        std::vector<double>& v = values[static_cast<size_t>(c)];
-        if (v.empty()) continue;
-        auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-        std::nth_element(v.begin(), middle, v.end());
-        median(b, c) = 1.4826 * *middle;
-      }
-    }
+    });
     Eigen::MatrixXd scale = median;
     for (Eigen::Index b = 0; b < blocks; ++b) {
       if (b > 0) scale.row(b) = scale.row(b).cwiseMax(median.row(b - 1));
@@ -309,7 +316,7 @@ void RefineSteps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::
 }  // namespace
 
 Jumps FindJumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<Eigen::Index>& gaps,
-                const Eigen::VectorXd& noise, const NoiseProfile* profile) {
+                const Eigen::VectorXd& noise, const NoiseProfile* profile, int threads) {
   Jumps jumps;
   if (t.size() < 2 * (kSide + kSkip) + 2) return jumps;
   SlopeScan scan(t, z, gaps, noise, profile);
@@ -319,8 +326,8 @@ Jumps FindJumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
   // The local scale is taken again each pass, without the slopes found so far: dense defects (a
   // correction every few samples) inflate the first pass's scale and hide all but the largest.
   for (int pass = 0; pass < kPasses; ++pass) {
-    const Eigen::MatrixXd departures = scan.Departures();
-    const Eigen::MatrixXd scale = scan.Scales(departures);
+    const Eigen::MatrixXd departures = scan.Departures(threads);
+    const Eigen::MatrixXd scale = scan.Scales(departures, threads);
     std::vector<std::pair<double, Eigen::Index>> candidates;
     for (Eigen::Index j = 0; j < n; ++j) {
       if (std::isnan(departures(j, 0))) continue;

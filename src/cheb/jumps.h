@@ -30,8 +30,9 @@ class NoiseProfile;
 /// t: sorted times (s), z: m x d samples, gaps: boundaries b that are already gaps (not crossed by
 /// the neighbour lines), noise: the samples' noise σ per coordinate (sets the floor of the local
 /// scale), `profile` (optional): the samples' noise profile, which raises that floor where the
-/// samples are noisier (a burst's slopes are not jumps). O(m) for a fixed neighbourhood.
+/// samples are noisier (a burst's slopes are not jumps). O(m) for a fixed neighbourhood; each
+/// pass's departures and scales are taken on up to `threads` threads.
 Jumps FindJumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<Eigen::Index>& gaps,
-                const Eigen::VectorXd& noise, const NoiseProfile* profile = nullptr);
+                const Eigen::VectorXd& noise, const NoiseProfile* profile = nullptr, int threads = 1);
 
 }  // namespace cheval::cheb::internal

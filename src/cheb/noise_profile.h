@@ -9,13 +9,18 @@
 
 namespace cheval::cheb::internal {
 
+/// The k-th smallest (from 0, k < size) of `values`, which are non-negative (not −0) and not NaN,
+/// as std::nth_element finds it; `values` may be reordered and shrunk.
+double SelectNonNegative(std::vector<double>* values, size_t k);
+
 /// The magnitudes of the 4th, 6th and 8th divided differences of every run of 5, 7 and 9
 /// consecutive samples (EstimateNoiseSigma(t, z, breaks), which is built on it in degree.cc),
 /// kept per run so that the estimate can be taken over any stretch of the samples.
 class DifferenceMagnitudes {
  public:
+  /// The three orders are taken on up to `threads` threads.
   DifferenceMagnitudes(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
-                       const std::vector<Eigen::Index>& breaks);
+                       const std::vector<Eigen::Index>& breaks, int threads = 1);
 
   /// EstimateNoiseSigma's estimate from the runs that start at samples [begin, end).
   Eigen::VectorXd Sigma(Eigen::Index begin, Eigen::Index end) const;

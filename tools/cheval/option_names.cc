@@ -42,6 +42,7 @@ constexpr std::array kFlags = std::to_array<OptionName>({
     {"CurveOptions::degree_method", "--degree"},
     {"CurveOptions::fixed_degree", "--degree"},
     {"CurveOptions::window_s", "--window"},
+    {"CurveOptions::threads", "--threads"},
     // cheb::CompressOptions
     {"CompressOptions::tolerance", "--tolerance"},
     // cheb::ModelGridStamps (`cheval sample --rate`)

@@ -23,6 +23,7 @@ struct VelocityFlags {
   std::string method{eval::ToString(options.method)};
   std::string degree = eval::DegreeName(options.curve);
   std::optional<double> window_s;  // unset: not given (a given 0 is refused by the library)
+  int threads = 0;
   std::string at_path;
   std::string json_path;
   InputFlags format;
@@ -37,6 +38,7 @@ eval::VelocityOptions ToOptions(const VelocityFlags& flags) {
   const bool savgol = options.method == eval::VelocityMethod::kSavitzkyGolay;
   options.curve = eval::CurveOptionsFromNames(flags.degree, savgol ? std::nullopt : window);
   if (savgol) options.savgol_window_s = window;
+  options.curve.threads = flags.threads;
   options.curve.progress = Progress().Fn();  // on a terminal only (progress.h)
   return options;
 }
@@ -121,6 +123,9 @@ void RegisterVelocity(CLI::App& app, Action* action) {
   command->add_option(Flag("CurveOptions::window_s"), flags->window_s,
                       "chebyshev: fixed window length in seconds (default: adaptive); savgol: window in seconds "
                       "(default 21 samples)");
+  command->add_option(Flag("CurveOptions::threads"), flags->threads,
+                      "chebyshev: threads for the fit and its evaluation (default 0: the machine's cores); the "
+                      "result is the same for any number");
   command->add_option("--at", flags->at_path,
                       "Evaluate at these stamps: a file of one stamp (s) per line, or a trajectory file");
   command->add_flag(Flag("VelocityOptions::angular"), flags->options.angular,

@@ -90,13 +90,17 @@ struct CurveOptions {
   /// regression"). Needs `lack_of_fit` and an adaptive fit. The angular fit turns it off: the
   /// charts' noise varies along them, and the choice relies on one σ.
   bool local_regression = true;
-  /// Told "fitting windows" with the samples fitted so far, as windows are accepted (may be empty).
+  /// Threads that fit the windows of an adaptive fit; 0 = as many as the machine has. The curve is
+  /// the same for any number: windows are fitted independently and put in time order.
+  int threads = 0;
+  /// Told "fitting windows" with the samples fitted so far, as windows are accepted (may be empty;
+  /// called from the fitting threads, one call at a time).
   ProgressFn progress;
 
   /// Throws OptionError naming the first field out of range: fixed_degree < 0 (with kFixed),
   /// window_s not positive and finite, max_conditioning <= 0, max_degree < 1,
   /// min_window_samples < 2, overlap outside [0, 1], gap_factor <= 1, min_gap_s < 0, noise_sigma
-  /// negative or not finite, end_degree < 0.
+  /// negative or not finite, end_degree < 0, threads < 0.
   void Validate() const;
 };
 
@@ -183,7 +187,9 @@ class Curve {
 
   /// Values (n x d) and, for order >= 1 and 2, first and second derivatives (n x d) at many stamps
   /// (any order; row i belongs to stamps_ns[i]). The same numbers as the point-wise calls, several
-  /// times faster: the queries a window serves are evaluated together by vectorised Clenshaw.
+  /// times faster: the queries a window serves are evaluated together by vectorised Clenshaw, and
+  /// many queries are split over the threads the curve was fitted with (CurveOptions::threads; all
+  /// cores for a curve from FromParts).
   void EvaluateMany(std::span<const int64_t> stamps_ns, int order, Eigen::MatrixXd* values,
                     Eigen::MatrixXd* first = nullptr, Eigen::MatrixXd* second = nullptr,
                     double tolerance_s = 0.0) const;
@@ -241,6 +247,7 @@ class Curve {
   friend Curve FitCurve(std::span<const int64_t>, const Eigen::Ref<const Eigen::MatrixXd>&, const CurveOptions&);
   int64_t origin_ns_ = 0;
   int dimension_ = 0;
+  int threads_ = 0;  // CurveOptions::threads, for EvaluateMany
   std::vector<CurveSegment> segments_;
   Eigen::VectorXd noise_sigma_;
   Eigen::Index noisier_samples_ = 0;

@@ -1,0 +1,210 @@
+// Threads in the curve fit (CurveOptions::threads): the work queue and selection it is built on,
+// and a curve that is the same for any number of threads.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <numeric>
+#include <random>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "cheval/cheb/curve.h"
+#include "noise_profile.h"
+#include "work_queue.h"
+
+namespace cheval::cheb {
+namespace {
+
+// Ranges [a, b) halved down to single elements: every pushed item is processed, on any number of
+// threads, and the leaves cover the range once.
+TEST(DrainWork, ProcessesEveryItemAndEveryItemPushed) {
+  struct Range {
+    int a, b;
+  };
+  for (const int threads : {1, 2, 5}) {
+    std::mutex mutex;
+    std::vector<int> leaves;
+    std::atomic<int> processed{0};
+    internal::DrainWork(std::vector<Range>{{0, 1000}, {1000, 1037}}, threads, [&](Range r, auto&& push) {
+      ++processed;
+      if (r.b - r.a > 1) {
+        const int middle = (r.a + r.b) / 2;
+        push(Range{middle, r.b});
+        push(Range{r.a, middle});
+        return;
+      }
+      const std::lock_guard<std::mutex> lock(mutex);
+      leaves.push_back(r.a);
+    });
+    std::sort(leaves.begin(), leaves.end());
+    std::vector<int> expected(1037);
+    std::iota(expected.begin(), expected.end(), 0);
+    EXPECT_EQ(leaves, expected) << threads << " threads";
+    EXPECT_EQ(processed.load(), 2 * 1037 - 2) << threads << " threads";  // a binary tree per root
+  }
+}
+
+// On one thread the last pushed item is taken first: depth first, left before right as pushed.
+TEST(DrainWork, OneThreadTakesTheLastPushedFirst) {
+  std::vector<int> order;
+  internal::DrainWork(std::vector<int>{1}, 1, [&](int item, auto&& push) {
+    order.push_back(item);
+    if (item < 4) {
+      push(2 * item + 1);
+      push(2 * item);
+    }
+  });
+  EXPECT_EQ(order, (std::vector<int>{1, 2, 4, 5, 3, 6, 7}));
+}
+
+// An exception in one item stops the others from taking more and reaches the caller once they
+// are done. Items take a millisecond, far longer than recording the exception: items taken last
+// first, the 50th throws and the rest are not taken.
+TEST(DrainWork, TheFirstExceptionIsRethrown) {
+  for (const int threads : {1, 3}) {
+    std::atomic<int> processed{0};
+    std::vector<int> items(200);
+    std::iota(items.begin(), items.end(), 0);
+    EXPECT_THROW(internal::DrainWork(items, threads,
+                                     [&](int item, auto&&) {
+                                       ++processed;
+                                       std::this_thread::sleep_for(std::chrono::milliseconds(1));
+                                       if (item == 150) throw std::runtime_error("item 150");
+                                     }),
+                 std::runtime_error);
+    EXPECT_LT(processed.load(), 100) << threads << " threads";
+  }
+}
+
+TEST(ParallelFor, CallsEachIndexOnce) {
+  for (const int threads : {1, 2, 8}) {
+    std::vector<std::atomic<int>> calls(37);
+    internal::ParallelFor(37, threads, [&](int i) { ++calls[static_cast<size_t>(i)]; });
+    for (const auto& c : calls) EXPECT_EQ(c.load(), 1) << threads << " threads";
+  }
+  internal::ParallelFor(0, 2, [](int) { FAIL(); });
+}
+
+// The narrowing by bits finds what std::nth_element finds, above and below the size where it
+// starts, with ties, zeros, infinities and subnormals.
+TEST(SelectNonNegative, FindsWhatNthElementFinds) {
+  std::mt19937_64 rng(3);
+  std::lognormal_distribution<double> spread(0.0, 3.0);
+  std::uniform_int_distribution<int> kind(0, 19);
+  for (const size_t size : {size_t{1}, size_t{2}, size_t{1000}, size_t{16384}, size_t{16385}, size_t{100003}}) {
+    std::vector<double> values(size);
+    for (double& v : values) {
+      switch (kind(rng)) {
+        case 0: v = 0.0; break;
+        case 1: v = std::numeric_limits<double>::infinity(); break;
+        case 2: v = std::numeric_limits<double>::denorm_min() * 7; break;
+        case 3: v = 1.25; break;  // ties
+        default: v = spread(rng);
+      }
+    }
+    for (const size_t k : {size_t{0}, size / 3, size / 2, size - 1}) {
+      std::vector<double> expected = values, selected = values;
+      std::nth_element(expected.begin(), expected.begin() + static_cast<std::ptrdiff_t>(k), expected.end());
+      EXPECT_EQ(internal::SelectNonNegative(&selected, k), expected[k]) << "size " << size << ", k " << k;
+    }
+  }
+  // Many equal values: every bucket the narrowing keeps holds them all.
+  std::vector<double> equal(50000, 0.5);
+  EXPECT_EQ(internal::SelectNonNegative(&equal, 25000), 0.5);
+}
+
+// A recording with two gaps, a glitch, a step of the values and a burst of noise: four segments,
+// jumps found and a raised noise profile, 11,000 samples (the fit, the end caps, the noise
+// estimate and the evaluation of all of them all split their work). Fitted on 1, 2 and 5 threads,
+// the curves are the same to the last bit, and so are their values and rates at the samples.
+TEST(Threads, TheCurveIsTheSameForAnyNumber) {
+  constexpr double kRate = 300.0, kNoise = 5e-5;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::vector<int64_t> stamps;
+  std::vector<Eigen::Vector3d> rows;
+  for (int i = 0; i < 40 * 300; ++i) {
+    const double t = i / kRate;
+    if ((t > 10.0 && t < 10.5) || (t > 25.0 && t < 25.3)) continue;  // gaps
+    Eigen::Vector3d p(std::sin(0.4 * t) + 1e-3 * std::sin(2 * M_PI * 7 * t), 0.5 * std::cos(0.3 * t),
+                      0.2 * std::sin(0.7 * t + 1.0));
+    const double noise = t > 30.0 && t < 30.2 ? 6 * kNoise : kNoise;  // a burst
+    for (int c = 0; c < 3; ++c) p[c] += noise * gauss(rng);
+    if (i == 1500) p[0] += 5e-3;  // a glitch
+    if (t > 17.0) p[1] += 3e-3;   // a step
+    stamps.push_back(std::llround(t * 1e9));
+    rows.push_back(p);
+  }
+  Eigen::MatrixXd values(static_cast<Eigen::Index>(rows.size()), 3);
+  for (size_t i = 0; i < rows.size(); ++i) values.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
+
+  auto fit = [&](int threads) {
+    CurveOptions options;
+    options.threads = threads;
+    return FitCurve(stamps, values, options);
+  };
+  const Curve one = fit(1);
+  ASSERT_GE(one.segments().size(), 3u);
+  ASSERT_FALSE(one.outlier_times().empty());
+  ASSERT_GT(one.noisier_samples(), 0);
+  Eigen::MatrixXd one_values, one_rates;
+  one.EvaluateMany(stamps, 1, &one_values, &one_rates);
+  for (const int threads : {2, 5}) {
+    const Curve many = fit(threads);
+    ASSERT_EQ(many.segments().size(), one.segments().size());
+    for (size_t k = 0; k < one.segments().size(); ++k) {
+      const std::vector<CurveWindow>& a = one.segments()[k].windows;
+      const std::vector<CurveWindow>& b = many.segments()[k].windows;
+      ASSERT_EQ(a.size(), b.size()) << "segment " << k;
+      for (size_t w = 0; w < a.size(); ++w) {
+        EXPECT_EQ(a[w].core_begin, b[w].core_begin);
+        EXPECT_EQ(a[w].core_end, b[w].core_end);
+        EXPECT_EQ(a[w].degrees, b[w].degrees);
+        EXPECT_EQ(a[w].series.coefficients, b[w].series.coefficients);
+        EXPECT_EQ(a[w].missed_motion, b[w].missed_motion);
+      }
+    }
+    EXPECT_EQ(many.outlier_times(), one.outlier_times());
+    EXPECT_EQ(many.jump_times(), one.jump_times());
+    EXPECT_EQ(many.step_times(), one.step_times());
+    EXPECT_EQ(many.noisier_samples(), one.noisier_samples());
+    EXPECT_EQ(many.noise_sigma(), one.noise_sigma());
+    EXPECT_EQ(many.residual_rms(), one.residual_rms());
+    Eigen::MatrixXd many_values, many_rates;
+    many.EvaluateMany(stamps, 1, &many_values, &many_rates);
+    EXPECT_EQ(many_values, one_values) << threads << " threads";
+    EXPECT_EQ(many_rates, one_rates) << threads << " threads";
+  }
+}
+
+// Progress comes from the fitting threads one call at a time: the samples done never fall, and
+// the stage ends with all of them.
+TEST(Threads, ProgressNeverFalls) {
+  std::vector<int64_t> stamps;
+  Eigen::MatrixXd values(20000, 1);
+  for (Eigen::Index i = 0; i < values.rows(); ++i) {
+    stamps.push_back(i * 5'000'000);
+    values(i, 0) = std::sin(0.01 * static_cast<double>(i)) + 1e-4 * std::cos(1.3 * static_cast<double>(i));
+  }
+  std::vector<int64_t> done;
+  CurveOptions options;
+  options.threads = 2;
+  options.progress = [&](std::string_view stage, int64_t d, int64_t total) {
+    EXPECT_EQ(stage, "fitting windows");
+    EXPECT_EQ(total, 20000);
+    done.push_back(d);
+  };
+  FitCurve(stamps, values, options);
+  ASSERT_GE(done.size(), 3u);
+  EXPECT_TRUE(std::is_sorted(done.begin(), done.end()));
+  EXPECT_EQ(done.back(), 20000);
+}
+
+}  // namespace
+}  // namespace cheval::cheb
