@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # End-to-end speed of `cheval velocity` (default) against `cheval velocity --method central` on the
 # same file, the read/write floor: the two commands alternate RUNS times and the script prints each
-# one's best and median CPU time (user + sys) and their ratio (docs/velocity.md, "Speed").
+# one's best and median wall-clock time and CPU time (user + sys, all threads), and their ratios
+# (docs/velocity.md, "Speed").
 #   bash bench/velocity_speed.sh [BUILD_DIR] [RUNS] [SAMPLES]
 set -euo pipefail
 build=${1:-build}
@@ -12,22 +13,25 @@ trap 'rm -rf "$work"' EXIT
 # A drone flight at 200 Hz with 0.5 mm of noise: SAMPLES + 1 samples.
 duration=$(awk -v m="$samples" 'BEGIN { printf "%.3f", m / 200 }')
 "$build/cheval" sim motion --kind drone --seed 1 --noise 0.0005 --duration "$duration" -o "$work/in.tum" > /dev/null
-cpu() {  # CPU seconds of one run of the command
-  /usr/bin/time -f "%U %S" -o "$work/time" "$@" > /dev/null 2>&1
-  awk '{ printf "%.3f\n", $1 + $2 }' "$work/time"
+timed() {  # appends the wall-clock and CPU seconds of one run of the command to files $1.wall, $1.cpu
+  local name=$1
+  shift
+  /usr/bin/time -f "%e %U %S" -o "$work/time" "$@" > /dev/null 2>&1
+  awk '{ printf "%.3f\n", $1 }' "$work/time" >> "$name.wall"
+  awk '{ printf "%.3f\n", $2 + $3 }' "$work/time" >> "$name.cpu"
 }
-: > "$work/default"
-: > "$work/central"
 for ((i = 0; i < runs; i++)); do
-  cpu "$build/cheval" velocity "$work/in.tum" -o "$work/out.tum" >> "$work/default"
-  cpu "$build/cheval" velocity "$work/in.tum" --method central -o "$work/out.tum" >> "$work/central"
+  timed "$work/default" "$build/cheval" velocity "$work/in.tum" -o "$work/out.tum"
+  timed "$work/central" "$build/cheval" velocity "$work/in.tum" --method central -o "$work/out.tum"
 done
 stats() { sort -n "$1" | awk '{ v[NR] = $1 } END { printf "%.3f %.3f", v[1], v[int((NR + 1) / 2)] }'; }
-read -r dbest dmed <<< "$(stats "$work/default")"
-read -r cbest cmed <<< "$(stats "$work/central")"
 lines=$(wc -l < "$work/in.tum")
-echo "samples: $lines, runs: $runs (alternating), CPU seconds best / median"
-echo "default:  $dbest / $dmed"
-echo "central:  $cbest / $cmed"
-awk -v d="$dbest" -v c="$cbest" -v dm="$dmed" -v cm="$cmed" \
-  'BEGIN { printf "ratio default / central: best %.2fx, median %.2fx (target <= 2x)\n", d / c, dm / cm }'
+echo "samples: $lines, runs: $runs (alternating), seconds best / median; $(nproc) cores"
+for kind in wall cpu; do
+  read -r dbest dmed <<< "$(stats "$work/default.$kind")"
+  read -r cbest cmed <<< "$(stats "$work/central.$kind")"
+  echo "$kind default:  $dbest / $dmed"
+  echo "$kind central:  $cbest / $cmed"
+  awk -v k="$kind" -v d="$dbest" -v c="$cbest" -v dm="$dmed" -v cm="$cmed" \
+    'BEGIN { printf "%s ratio default / central: best %.2fx, median %.2fx (target <= 2x)\n", k, d / c, dm / cm }'
+done
