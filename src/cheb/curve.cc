@@ -228,9 +228,12 @@ class WindowFitter {
   // Whether the window of core [a, b] resolves the motion at its top degree (Fit's probe, the
   // subsample's too) with a residual there clearly consistent with the noise: a lack-of-fit score
   // of at most kSplitScore in every coordinate. Fit may split a window that does not for missed
-  // motion, which marks its pieces (CurveWindow::missed_motion); FitAdaptive cuts an end window
-  // unfitted only when it passes.
-  bool ResolvedAtTop(double a, double b, double segment_begin, double segment_end) const {
+  // motion, which marks its pieces (CurveWindow::missed_motion); FitCore cuts an end window
+  // unfitted only when it passes. `subsample_unresolved` is set when the subsample probe fails:
+  // Fit with may_split then returns nullopt for the same window at once (the same probe), with
+  // nothing marked.
+  bool ResolvedAtTop(double a, double b, double segment_begin, double segment_end,
+                     bool* subsample_unresolved = nullptr) const {
     const Span span = Samples(a, b, segment_begin, segment_end);
     if (span.distinct < 2 || !(span.interval.b > span.interval.a)) return false;
     const int top = TopDegree(span);
@@ -238,7 +241,10 @@ class WindowFitter {
     const auto zw = z_.middleRows(span.first, span.count);
     const Eigen::VectorXd level = noise_.Over(span.first, span.count);
     const Eigen::Index stride = SubsampleStride(span.count, top);
-    if (stride >= 2 && !ResolvedOnSubsample(tw, zw, level, stride, top, span.interval)) return false;
+    if (stride >= 2 && !ResolvedOnSubsample(tw, zw, level, stride, top, span.interval)) {
+      if (subsample_unresolved != nullptr) *subsample_unresolved = true;
+      return false;
+    }
     const NormalEquations normal = BuildNormalEquations(tw, zw, top, span.interval);
     try {
       const NestedCholesky cholesky(normal, top);
@@ -720,11 +726,18 @@ std::optional<CurveWindow> FitCore(const WindowFitter& fitter, const Eigen::Vect
   const bool front = a == segment.begin, back = b == segment.end;
   const bool refine_ends = options.end_degree > 0 && options.degree_method == DegreeMethod::kCrossValidation;
   const bool refinable = refine_ends && (front || back) && inside >= EndWindowMinimum(options);
-  if (refinable && !fitted &&
-      fitter.DegreeCertainlyAbove(a, b, segment.begin, segment.end, options.end_degree) &&
-      (end_piece || fitter.ResolvedAtTop(a, b, segment.begin, segment.end))) {
-    cut(front, back && !front, false, {});
-    return std::nullopt;
+  if (refinable && !fitted && fitter.DegreeCertainlyAbove(a, b, segment.begin, segment.end, options.end_degree)) {
+    bool subsample_unresolved = false;
+    if (end_piece || fitter.ResolvedAtTop(a, b, segment.begin, segment.end, &subsample_unresolved)) {
+      cut(front, back && !front, false, {});
+      return std::nullopt;
+    }
+    // What Fit would do after the same subsample probe: on a long recording, that probe of the
+    // whole segment and of its halves was taken twice.
+    if (subsample_unresolved && may_split) {
+      cut(false, false, core.piece, {});
+      return std::nullopt;
+    }
   }
   Eigen::VectorXd held_out;
   bool undecided = false, missed = false;
@@ -772,62 +785,84 @@ std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::Ve
   return windows;
 }
 
-// Halves the first and the last window of a segment while their degree exceeds
-// options.end_degree and they keep enough samples to be split; the inner half is refitted
-// adaptively (it may need splitting itself).
-void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegment& segment,
-                const CurveOptions& options) {
-  if (options.end_degree <= 0) return;
+// The windows that replace a segment's end window `end` (its first with `front`, else its last):
+// it is halved while its degree exceeds options.end_degree and it keeps enough samples to be
+// split; the inner half is refitted adaptively (it may need splitting itself).
+std::vector<CurveWindow> RefineEnd(const WindowFitter& fitter, const Eigen::VectorXd& t, const CurveSegment& segment,
+                                   CurveWindow end_window, bool front, const CurveOptions& options) {
   const Eigen::Index minimum = EndWindowMinimum(options);
-  for (const bool front : {true, false}) {
-    while (true) {
-      auto& windows = segment.windows;
-      const CurveWindow& end = front ? windows.front() : windows.back();
-      if (MaxDegree(end) <= options.end_degree || SamplesIn(t, end.core_begin, end.core_end) < minimum) break;
-      // Halving one step at a time fits every outer half on the way and drops all but the last.
-      // A resolved motion needs a degree about proportional to the window's length, so the cuts
-      // the halvings are expected to make are taken at once (each halved piece holding enough
-      // samples), and the end piece is checked from there back outwards: while the next larger
-      // piece would already have stopped the halving (degree at most end_degree), it is the end
-      // piece. The windows are those the one-by-one halving leaves (its degrees fall as its length
-      // does), for two fits of the end piece instead of one per halving. Cross-validated degrees
-      // follow the length; standardChop's jump to the noise plateau and do not, so with it the
-      // end window is halved one step at a time.
-      const double a = end.core_begin, b = end.core_end;
-      const bool predict = options.degree_method == DegreeMethod::kCrossValidation;
-      std::vector<double> cuts{front ? b : a};  // from the inside out
-      for (double degree = MaxDegree(end); degree > options.end_degree && (predict || cuts.size() < 2); degree *= 0.5) {
-        if (cuts.size() > 1 && (front ? SamplesIn(t, a, cuts.back()) : SamplesIn(t, cuts.back(), b)) < minimum) break;
-        cuts.push_back(front ? 0.5 * (a + cuts.back()) : 0.5 * (cuts.back() + b));
-      }
-      auto fit_end = [&](double cut) {
-        return front ? *fitter.Fit(a, cut, segment.begin, segment.end, false)
-                     : *fitter.Fit(cut, b, segment.begin, segment.end, false);
-      };
-      CurveWindow outer = fit_end(cuts.back());
-      while (cuts.size() > 2 && MaxDegree(outer) <= options.end_degree) {
-        CurveWindow larger = fit_end(cuts[cuts.size() - 2]);
-        if (MaxDegree(larger) > options.end_degree) break;
-        cuts.pop_back();
-        outer = std::move(larger);
-      }
-      std::vector<CurveWindow> refined;
-      auto append = [&refined](std::vector<CurveWindow> more) {
-        refined.insert(refined.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
-      };
-      if (front) {
-        refined.push_back(std::move(outer));
-        for (size_t k = cuts.size() - 1; k >= 1; --k) append(FitAdaptive(fitter, t, segment, cuts[k], cuts[k - 1], options));
-        windows.erase(windows.begin());
-        windows.insert(windows.begin(), std::make_move_iterator(refined.begin()), std::make_move_iterator(refined.end()));
-      } else {
-        for (size_t k = 1; k < cuts.size(); ++k) append(FitAdaptive(fitter, t, segment, cuts[k - 1], cuts[k], options));
-        refined.push_back(std::move(outer));
-        windows.pop_back();
-        windows.insert(windows.end(), std::make_move_iterator(refined.begin()), std::make_move_iterator(refined.end()));
-      }
+  std::vector<CurveWindow> windows{std::move(end_window)};
+  while (true) {
+    const CurveWindow& end = front ? windows.front() : windows.back();
+    if (MaxDegree(end) <= options.end_degree || SamplesIn(t, end.core_begin, end.core_end) < minimum) break;
+    // Halving one step at a time fits every outer half on the way and drops all but the last.
+    // A resolved motion needs a degree about proportional to the window's length, so the cuts
+    // the halvings are expected to make are taken at once (each halved piece holding enough
+    // samples), and the end piece is checked from there back outwards: while the next larger
+    // piece would already have stopped the halving (degree at most end_degree), it is the end
+    // piece. The windows are those the one-by-one halving leaves (its degrees fall as its length
+    // does), for two fits of the end piece instead of one per halving. Cross-validated degrees
+    // follow the length; standardChop's jump to the noise plateau and do not, so with it the
+    // end window is halved one step at a time.
+    const double a = end.core_begin, b = end.core_end;
+    const bool predict = options.degree_method == DegreeMethod::kCrossValidation;
+    std::vector<double> cuts{front ? b : a};  // from the inside out
+    for (double degree = MaxDegree(end); degree > options.end_degree && (predict || cuts.size() < 2); degree *= 0.5) {
+      if (cuts.size() > 1 && (front ? SamplesIn(t, a, cuts.back()) : SamplesIn(t, cuts.back(), b)) < minimum) break;
+      cuts.push_back(front ? 0.5 * (a + cuts.back()) : 0.5 * (cuts.back() + b));
+    }
+    auto fit_end = [&](double cut) {
+      return front ? *fitter.Fit(a, cut, segment.begin, segment.end, false)
+                   : *fitter.Fit(cut, b, segment.begin, segment.end, false);
+    };
+    CurveWindow outer = fit_end(cuts.back());
+    while (cuts.size() > 2 && MaxDegree(outer) <= options.end_degree) {
+      CurveWindow larger = fit_end(cuts[cuts.size() - 2]);
+      if (MaxDegree(larger) > options.end_degree) break;
+      cuts.pop_back();
+      outer = std::move(larger);
+    }
+    std::vector<CurveWindow> refined;
+    auto append = [&refined](std::vector<CurveWindow> more) {
+      refined.insert(refined.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
+    };
+    if (front) {
+      refined.push_back(std::move(outer));
+      for (size_t k = cuts.size() - 1; k >= 1; --k) append(FitAdaptive(fitter, t, segment, cuts[k], cuts[k - 1], options));
+      windows.erase(windows.begin());
+      windows.insert(windows.begin(), std::make_move_iterator(refined.begin()), std::make_move_iterator(refined.end()));
+    } else {
+      for (size_t k = 1; k < cuts.size(); ++k) append(FitAdaptive(fitter, t, segment, cuts[k - 1], cuts[k], options));
+      refined.push_back(std::move(outer));
+      windows.pop_back();
+      windows.insert(windows.end(), std::make_move_iterator(refined.begin()), std::make_move_iterator(refined.end()));
     }
   }
+  return windows;
+}
+
+// Refines the first and the last window of a segment (RefineEnd), the front first. With two
+// windows or more the two ends do not touch and are refined on up to `threads` threads.
+void RefineEnds(const WindowFitter& fitter, const Eigen::VectorXd& t, CurveSegment& segment,
+                const CurveOptions& options, int threads) {
+  if (options.end_degree <= 0) return;
+  std::vector<CurveWindow>& windows = segment.windows;
+  if (windows.size() == 1) {
+    windows = RefineEnd(fitter, t, segment, std::move(windows.front()), true, options);
+    std::vector<CurveWindow> back = RefineEnd(fitter, t, segment, std::move(windows.back()), false, options);
+    windows.pop_back();
+    windows.insert(windows.end(), std::make_move_iterator(back.begin()), std::make_move_iterator(back.end()));
+    return;
+  }
+  std::array<std::vector<CurveWindow>, 2> ends;
+  internal::ParallelFor(2, threads, [&](int side) {
+    const bool front = side == 0;
+    ends[static_cast<size_t>(side)] = RefineEnd(fitter, t, segment, front ? windows.front() : windows.back(), front, options);
+  });
+  std::vector<CurveWindow> refined = std::move(ends[0]);
+  refined.insert(refined.end(), std::make_move_iterator(windows.begin() + 1), std::make_move_iterator(windows.end() - 1));
+  refined.insert(refined.end(), std::make_move_iterator(ends[1].begin()), std::make_move_iterator(ends[1].end()));
+  windows = std::move(refined);
 }
 
 // Up to 4 coordinates, on the stack: evaluation allocates nothing.
@@ -1080,7 +1115,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
       segment.windows = std::move(windows[k]);
       std::sort(segment.windows.begin(), segment.windows.end(),
                 [](const CurveWindow& x, const CurveWindow& y) { return x.core_begin < y.core_begin; });
-      RefineEnds(fitter, t, segment, options);
+      RefineEnds(fitter, t, segment, options, threads);
     }
   }
 
