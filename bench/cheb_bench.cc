@@ -32,6 +32,25 @@ void BM_FitLeastSquares(benchmark::State& state) {
 }
 BENCHMARK(BM_FitLeastSquares)->Args({100'000, 400})->Args({20'000, 200})->Unit(benchmark::kMillisecond);
 
+// Evaluation of a series of degree N with 3 columns at m points (vectorised Clenshaw): what the
+// residual tests, the end caps and Curve::EvaluateMany spend; items are point-degrees.
+void BM_EvaluateSeries(benchmark::State& state) {
+  const auto m = static_cast<Eigen::Index>(state.range(0));
+  const auto degree = static_cast<Eigen::Index>(state.range(1));
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  Eigen::MatrixXd coefficients(degree + 1, 3);
+  for (Eigen::Index k = 0; k <= degree; ++k) {
+    for (int c = 0; c < 3; ++c) coefficients(k, c) = gauss(rng) / static_cast<double>(1 + k * k);
+  }
+  const Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(m, -1.0, 1.0);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(EvaluateSeries(coefficients, x));
+  }
+  state.SetItemsProcessed(state.iterations() * m * degree * 3);
+}
+BENCHMARK(BM_EvaluateSeries)->Args({100'000, 140})->Args({1'000, 20})->Unit(benchmark::kMillisecond);
+
 // The whole adaptive curve fit (windows, cross-validation, end refinement) of m samples at 200 Hz
 // of a 3-D motion with 0.5 mm noise: what `cheval velocity` spends between reading and writing,
 // apart from the evaluation.

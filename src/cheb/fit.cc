@@ -327,25 +327,37 @@ CHEVAL_MULTIVERSION Eigen::MatrixXd EvaluateSeries(const Eigen::Ref<const Eigen:
                                                    const Eigen::Ref<const Eigen::VectorXd>& x) {
   const Eigen::Index n = coefficients.rows() - 1, m = x.size(), d = coefficients.cols();
   Eigen::MatrixXd result(m, d);
-  // kPoints points at a time: independent Clenshaw chains the compiler vectorises. One chain (or
-  // one vector of kLanes chains) is bound by the latency of its multiply-add; 4 vectors of them
-  // keep both FMA ports busy. Each point's recurrence is the same arithmetic in any case.
-  constexpr int kPoints = 4 * kLanes;
+  // kPoints points at a time: independent Clenshaw chains, in kVectors vectors of kLanes that stay
+  // in registers. One vector of chains is bound by the latency of its multiply-add; 8 of them keep
+  // the FMA ports busy. Each point's recurrence is the same arithmetic in any case.
+  using Vector = double __attribute__((vector_size(kLanes * sizeof(double))));
+  constexpr int kVectors = 8, kPoints = kVectors * kLanes;
   for (Eigen::Index c = 0; c < d; ++c) {
     const double* a = coefficients.col(c).data();
     for (Eigen::Index begin = 0; begin < m; begin += kPoints) {
       const int count = static_cast<int>(std::min<Eigen::Index>(kPoints, m - begin));
-      alignas(64) double xs[kPoints], b1[kPoints] = {}, b2[kPoints] = {};
-      for (int l = 0; l < kPoints; ++l) xs[l] = l < count ? x[begin + l] : 0.0;
+      Vector two_x[kVectors], b1[kVectors], b2[kVectors];
+      for (int v = 0; v < kVectors; ++v) {
+        for (int l = 0; l < kLanes; ++l) {
+          const int p = v * kLanes + l;
+          two_x[v][l] = 2.0 * (p < count ? x[begin + p] : 0.0);
+        }
+        b1[v] = Vector{} + 0.0;
+        b2[v] = Vector{} + 0.0;
+      }
       for (Eigen::Index k = n; k >= 1; --k) {
         const double ak = a[k];
-        for (int l = 0; l < kPoints; ++l) {
-          const double b0 = 2.0 * xs[l] * b1[l] - b2[l] + ak;
-          b2[l] = b1[l];
-          b1[l] = b0;
+#pragma GCC unroll 8
+        for (int v = 0; v < kVectors; ++v) {
+          const Vector b0 = two_x[v] * b1[v] - b2[v] + ak;
+          b2[v] = b1[v];
+          b1[v] = b0;
         }
       }
-      for (int l = 0; l < count; ++l) result(begin + l, c) = xs[l] * b1[l] - b2[l] + a[0];
+      for (int p = 0; p < count; ++p) {
+        const int v = p / kLanes, l = p % kLanes;
+        result(begin + p, c) = 0.5 * two_x[v][l] * b1[v][l] - b2[v][l] + a[0];
+      }
     }
   }
   return result;
