@@ -14,17 +14,19 @@ trap 'rm -rf "$work"' EXIT
 duration=$(awk -v m="$samples" 'BEGIN { printf "%.3f", m / 200 }')
 "$build/cheval" sim motion --kind drone --seed 1 --noise 0.0005 --duration "$duration" -o "$work/in.tum" > /dev/null
 timed() {  # appends the wall-clock and CPU seconds of one run of the command to files $1.wall, $1.cpu
-  local name=$1
+  local name=$1 start end
   shift
-  /usr/bin/time -f "%e %U %S" -o "$work/time" "$@" > /dev/null 2>&1
-  awk '{ printf "%.3f\n", $1 }' "$work/time" >> "$name.wall"
-  awk '{ printf "%.3f\n", $2 + $3 }' "$work/time" >> "$name.cpu"
+  start=$EPOCHREALTIME  # microseconds; /usr/bin/time's %e has 10 ms steps
+  /usr/bin/time -f "%U %S" -o "$work/time" "$@" > /dev/null 2>&1
+  end=$EPOCHREALTIME
+  awk -v a="$start" -v b="$end" 'BEGIN { printf "%.4f\n", b - a }' >> "$name.wall"
+  awk '{ printf "%.3f\n", $1 + $2 }' "$work/time" >> "$name.cpu"
 }
 for ((i = 0; i < runs; i++)); do
   timed "$work/default" "$build/cheval" velocity "$work/in.tum" -o "$work/out.tum"
   timed "$work/central" "$build/cheval" velocity "$work/in.tum" --method central -o "$work/out.tum"
 done
-stats() { sort -n "$1" | awk '{ v[NR] = $1 } END { printf "%.3f %.3f", v[1], v[int((NR + 1) / 2)] }'; }
+stats() { sort -n "$1" | awk '{ v[NR] = $1 } END { printf "%.4f %.4f", v[1], v[int((NR + 1) / 2)] }'; }
 lines=$(wc -l < "$work/in.tum")
 echo "samples: $lines, runs: $runs (alternating), seconds best / median; $(nproc) cores"
 for kind in wall cpu; do
