@@ -36,9 +36,12 @@ struct Moments {
   Eigen::MatrixXd b;             // Σω T_n z, (N + 1) x d
 };
 
-// Built twice where the compiler supports function multi-versioning: for x86-64-v3 (AVX2 + FMA)
-// and the baseline; the loader picks the one the CPU runs.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+// Built three times where the compiler supports function multi-versioning: for x86-64-v4
+// (AVX-512), x86-64-v3 (AVX2 + FMA) and the baseline; the loader picks the one the CPU runs. Not
+// under the address or thread sanitizer: the loader runs the picking function before their
+// runtimes start (ThreadSanitizer crashed there).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__) && \
+    !defined(__SANITIZE_THREAD__)
 #define CHEVAL_MULTIVERSION __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #else
 #define CHEVAL_MULTIVERSION
