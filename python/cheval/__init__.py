@@ -145,7 +145,7 @@ Trajectory.to_dict = _trajectory_to_dict
 
 
 def velocity(source, *, at=None, method="chebyshev", degree="auto", window=None, savgol_window=21,
-             angular=False, format="auto", columns=None, kitti_times=None, quat_order=None):
+             angular=False, threads=0, format="auto", columns=None, kitti_times=None, quat_order=None):
     """World-frame linear velocity from positions, as ``cheval velocity`` (docs/velocity.md).
 
     source: a path, Trajectory or mapping (positions are used; orientations with angular=True).
@@ -154,7 +154,8 @@ def velocity(source, *, at=None, method="chebyshev", degree="auto", window=None,
     degree: 'auto' (= 'cv'), 'chop' or an int (a fixed degree: one global fit unless
     a window is given); window: the Chebyshev window in seconds (default adaptive);
     savgol_window: the Savitzky-Golay window in samples (odd, >= 5). angular: also body angular
-    velocity from the orientations.
+    velocity from the orientations. threads: for the Chebyshev fit (0: every core; the result is
+    the same for any number).
 
     Returns a dict: 'stamps' (n,) int64, 'velocities' (n, 3) m/s, 'positions' (n, 3) fitted
     (chebyshev; else None), 'angular_velocities' (n, 3) rad/s or None, 'orientations' (n, 4) x y z w
@@ -165,25 +166,27 @@ def velocity(source, *, at=None, method="chebyshev", degree="auto", window=None,
     """
     trajectory = _trajectory(source, format, columns, kitti_times, quat_order)
     out = _cheval.velocity(trajectory, at=None if at is None else _stamps(at), method=method,
-                           degree=degree, window=window, savgol_window=savgol_window, angular=angular)
+                           degree=degree, window=window, savgol_window=savgol_window, angular=angular,
+                           threads=threads)
     if trajectory.quat_order == "wxyz" and out.get("orientations") is not None:
         import numpy as _np
         out["orientations"] = _np.roll(out["orientations"], 1, axis=1)
     return out
 
 
-def fit(source, values=None, *, degree="auto", window=None, noise=None, format="auto", columns=None,
-        kitti_times=None):
+def fit(source, values=None, *, degree="auto", window=None, noise=None, threads=0, format="auto",
+        columns=None, kitti_times=None):
     """A Curve fitted to samples: fit(stamps, values) with int64 stamps (ns) and values (n, d),
     d <= 4, or fit(trajectory_or_path) for its positions. Evaluate it with curve.evaluate(stamps,
     order). degree: 'auto' (= 'cv'), 'chop' or an int; window (s); noise (sigma of the
-    samples; default estimated). See cheval.Curve.
+    samples; default estimated); threads (0: every core; the curve is the same for any number).
+    See cheval.Curve.
     """
     if values is not None:
         _cheval.check_real(values, "values")
-        return _cheval.fit(source, values, degree=degree, window=window, noise=noise)
+        return _cheval.fit(source, values, degree=degree, window=window, noise=noise, threads=threads)
     return _cheval.fit(_trajectory(source, format, columns, kitti_times), degree=degree, window=window,
-                       noise=noise)
+                       noise=noise, threads=threads)
 
 
 def compress(source, values=None, *, tolerance=None, format="auto", columns=None, kitti_times=None):

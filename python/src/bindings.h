@@ -92,7 +92,8 @@ inline std::span<const int64_t> SpanOf(const py::array_t<int64_t>& stamps) {
 /// Curve options from the Python arguments of fit and velocity: degree 'auto' (= 'cv'), 'chop' or
 /// an int (eval::CurveOptionsFromNames), window (s) and noise sigma (None: adaptive /
 /// estimated). The library validates the values (OptionError).
-cheb::CurveOptions CurveOptionsOf(const py::object& degree, std::optional<double> window, std::optional<double> noise);
+cheb::CurveOptions CurveOptionsOf(const py::object& degree, std::optional<double> window, std::optional<double> noise,
+                                  int threads);
 
 /// The keyword argument of a library options field ("AlignmentOptions::n_align" -> "n_align"), from
 /// the one table of python/src/option_names.cc; std::logic_error for a field not in it.

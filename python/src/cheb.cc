@@ -71,7 +71,8 @@ cheb::Compression CompressSamples(std::span<const int64_t> stamps, const Eigen::
 
 }  // namespace
 
-cheb::CurveOptions CurveOptionsOf(const py::object& degree, std::optional<double> window, std::optional<double> noise) {
+cheb::CurveOptions CurveOptionsOf(const py::object& degree, std::optional<double> window, std::optional<double> noise,
+                                  int threads) {
   std::string name;
   if (py::isinstance<py::str>(degree)) {
     name = degree.cast<std::string>();
@@ -82,6 +83,7 @@ cheb::CurveOptions CurveOptionsOf(const py::object& degree, std::optional<double
   }
   cheb::CurveOptions options = eval::CurveOptionsFromNames(name, window);
   options.noise_sigma = noise;
+  options.threads = threads;
   return options;
 }
 
@@ -121,29 +123,31 @@ Raises ComputeError for a stamp outside the data by more than `tolerance` second
   m.def(
       "fit",
       [](const py::handle& stamps_in, const Eigen::Ref<const Eigen::MatrixXd>& values, const py::object& degree,
-         std::optional<double> window, std::optional<double> noise) {
-        const cheb::CurveOptions options = CurveOptionsOf(degree, window, noise);
+         std::optional<double> window, std::optional<double> noise, int threads) {
+        const cheb::CurveOptions options = CurveOptionsOf(degree, window, noise, threads);
         const py::array_t<int64_t> stamps = StampsArray(stamps_in);
         py::gil_scoped_release release;
         return cheb::FitCurve(SpanOf(stamps), values, options);
       },
       py::arg("stamps"), py::arg("values"), py::kw_only(), py::arg("degree") = "auto", py::arg("window") = py::none(),
-      py::arg("noise") = py::none(),
+      py::arg("noise") = py::none(), py::arg("threads") = 0,
       R"(Fits samples `values` (n x d, d <= 4) taken at int64 `stamps` (ns, any order) with a Curve.
 degree: 'auto' (= 'cv', cross-validation per window), 'chop' or an int (a fixed
 degree: one global fit unless `window` is given); window: fixed window length in seconds
-(default adaptive); noise: the samples' noise sigma (default estimated). values is used without a
-copy when it is a Fortran-ordered float64 array, copied otherwise.)");
+(default adaptive); noise: the samples' noise sigma (default estimated); threads: for the fit (0:
+every core; the curve is the same for any number). values is used without a copy when it is a
+Fortran-ordered float64 array, copied otherwise.)");
   m.def(
       "fit",
-      [](const PyTrajectory& t, const py::object& degree, std::optional<double> window, std::optional<double> noise) {
-        const cheb::CurveOptions options = CurveOptionsOf(degree, window, noise);
+      [](const PyTrajectory& t, const py::object& degree, std::optional<double> window, std::optional<double> noise,
+         int threads) {
+        const cheb::CurveOptions options = CurveOptionsOf(degree, window, noise, threads);
         const Samples samples = SamplesOf(t);
         py::gil_scoped_release release;
         return cheb::FitCurve(samples.stamps, samples.values, options);
       },
       py::arg("trajectory"), py::kw_only(), py::arg("degree") = "auto", py::arg("window") = py::none(),
-      py::arg("noise") = py::none(), "The Curve of a Trajectory's positions (same options).");
+      py::arg("noise") = py::none(), py::arg("threads") = 0, "The Curve of a Trajectory's positions (same options).");
 
   py::class_<cheb::TrajectoryModel>(m, "Model", R"(A trajectory's pseudo-spectral model (docs/compress.md): windowed
 Chebyshev polynomials held by their values at Chebyshev points. From cheval.compress or

@@ -29,7 +29,7 @@ bool OneOf(const std::string& value, const char* option, const char* first, cons
 }
 
 py::dict Velocity(const py::object& self, const py::object& at, const std::string& method, const py::object& degree,
-                  std::optional<double> window, int savgol_window, bool angular) {
+                  std::optional<double> window, int savgol_window, bool angular, int threads) {
   const PyTrajectory& t = self.cast<const PyTrajectory&>();
   const traj::TrajectoryView view = t.trajectory.View();
   eval::VelocityOptions options;
@@ -38,7 +38,7 @@ py::dict Velocity(const py::object& self, const py::object& at, const std::strin
     throw UsageError("window= is the Chebyshev window in seconds; give the Savitzky-Golay window in samples with "
                      "savgol_window=");
   }
-  options.curve = CurveOptionsOf(degree, window, std::nullopt);
+  options.curve = CurveOptionsOf(degree, window, std::nullopt, threads);
   options.savgol_window = savgol_window;
   options.angular = angular;
   std::optional<py::array_t<int64_t>> query;
@@ -179,7 +179,7 @@ void BindEvaluation(py::module_& m) {
         k("VelocityOptions::method") = std::string(eval::ToString(velocity.method)),
         k("CurveOptions::degree_method") = eval::DegreeName(velocity.curve), k("CurveOptions::window_s") = py::none(),
         k("VelocityOptions::savgol_window") = velocity.savgol_window, k("VelocityOptions::angular") = velocity.angular,
-        "The compiled velocity; use cheval.velocity (docs/python.md).");
+        k("CurveOptions::threads") = velocity.curve.threads, "The compiled velocity; use cheval.velocity (docs/python.md).");
   m.def("associate", &Associate, py::arg("ref"), py::arg("est"), py::kw_only(),
         k("AssociationOptions::max_diff_ns") = defaults.association.max_diff_s(),
         k("AssociationOptions::offset_ns") = defaults.association.offset_s(),

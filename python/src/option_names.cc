@@ -44,6 +44,7 @@ constexpr std::array kKeywords = std::to_array<OptionName>({
     {"CurveOptions::fixed_degree", "degree"},
     {"CurveOptions::window_s", "window"},
     {"CurveOptions::noise_sigma", "noise"},
+    {"CurveOptions::threads", "threads"},
     // cheb::CompressOptions
     {"CompressOptions::tolerance", "tolerance"},
     // sim::MotionOptions, MeasurementOptions (cheval.simulate)

@@ -106,6 +106,19 @@ class VelocityTest(unittest.TestCase):
         with self.assertRaises(cheval.UsageError) as raised:
             cheval.velocity(self.measured, window=-1.0)
         self.assertEqual(str(raised.exception), "window must be a positive number of seconds, got -1")
+        with self.assertRaises(cheval.UsageError) as raised:
+            cheval.velocity(self.measured, threads=-1)
+        self.assertEqual(str(raised.exception), "threads must be non-negative (0: every core), got -1")
+
+    def test_the_same_numbers_on_any_number_of_threads(self):
+        one = cheval.velocity(self.measured, threads=1, angular=True)
+        for threads in (2, 3):
+            many = cheval.velocity(self.measured, threads=threads, angular=True)
+            np.testing.assert_array_equal(many["velocities"], one["velocities"])
+            np.testing.assert_array_equal(many["angular_velocities"], one["angular_velocities"])
+        curve = cheval.fit(self.measured, threads=2)
+        np.testing.assert_array_equal(curve.evaluate(self.truth.stamps, order=1)[1],
+                                      cheval.fit(self.measured, threads=1).evaluate(self.truth.stamps, order=1)[1])
 
 
 class FitTest(unittest.TestCase):
