@@ -108,7 +108,7 @@ class VelocityTest(unittest.TestCase):
         self.assertEqual(str(raised.exception), "window must be a positive number of seconds, got -1")
         with self.assertRaises(cheval.UsageError) as raised:
             cheval.velocity(self.measured, threads=-1)
-        self.assertEqual(str(raised.exception), "threads must be non-negative (0: every core), got -1")
+        self.assertEqual(str(raised.exception), "threads must be in 0..256 (0: every core), got -1")
 
     def test_the_same_numbers_on_any_number_of_threads(self):
         one = cheval.velocity(self.measured, threads=1, angular=True)

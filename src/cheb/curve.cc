@@ -701,6 +701,10 @@ struct Core {
   std::optional<HalfFit> fitted = std::nullopt;
 };
 
+// The order in which one thread fits cores (from a stack, left halves first): by segment, then
+// start, then the longer first (a core before its halves).
+std::tuple<size_t, double, double> CoreOrder(const Core& core) { return {core.segment, core.a, -core.b}; }
+
 // Fits a core of `segment` adaptively: returns its window when it is accepted, else pushes the two
 // halves it is cut into (the right one first, so that the left is taken first from a stack). A
 // core is halved until its series resolves or it gets too small to split; each core depends on
@@ -777,11 +781,14 @@ std::optional<CurveWindow> FitCore(const WindowFitter& fitter, const Eigen::Vect
 std::vector<CurveWindow> FitAdaptive(const WindowFitter& fitter, const Eigen::VectorXd& t, const CurveSegment& segment,
                                      double a0, double b0, const CurveOptions& options) {
   std::vector<CurveWindow> windows;
-  internal::DrainWork(std::vector<Core>{Core{0, a0, b0}}, 1, [&](Core core, auto&& push) {
-    if (std::optional<CurveWindow> window = FitCore(fitter, t, segment, options, std::move(core), push)) {
-      windows.push_back(std::move(*window));
-    }
-  });
+  internal::DrainWork(
+      std::vector<Core>{Core{0, a0, b0}}, 1,
+      [&](Core core, auto&& push) {
+        if (std::optional<CurveWindow> window = FitCore(fitter, t, segment, options, std::move(core), push)) {
+          windows.push_back(std::move(*window));
+        }
+      },
+      CoreOrder);
   return windows;
 }
 
@@ -918,7 +925,8 @@ void CurveOptions::Validate() const {
   check(!noise_sigma || (*noise_sigma >= 0.0 && std::isfinite(*noise_sigma)), "noise_sigma",
         "must be a non-negative number, got {}", noise_sigma.value_or(0.0));
   check(end_degree >= 0, "end_degree", "must be non-negative (0: no end refinement), got {}", end_degree);
-  check(threads >= 0, "threads", "must be non-negative (0: every core), got {}", threads);
+  check(threads >= 0 && threads <= internal::kMaxThreads, "threads", "must be in 0..{} (0: every core), got {}",
+        internal::kMaxThreads, threads);
 }
 
 Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen::MatrixXd>& values,
@@ -1100,21 +1108,30 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     std::vector<std::vector<CurveWindow>> windows(curve.segments_.size());
     std::mutex windows_mutex;
     Eigen::Index done = 0;
-    internal::DrainWork(std::move(roots), threads, [&](Core core, auto&& push) {
-      const size_t k = core.segment;
-      const Eigen::Index inside = SamplesIn(t, core.a, core.b);
-      std::optional<CurveWindow> window = FitCore(fitter, t, curve.segments_[k], options, std::move(core), push);
-      if (!window) return;
-      const std::lock_guard<std::mutex> lock(windows_mutex);
-      windows[k].push_back(std::move(*window));
-      done = std::min(fitted_count, done + inside);
-      ReportProgress(options.progress, "fitting windows", done, fitted_count);
-    });
+    internal::DrainWork(
+        std::move(roots), threads,
+        [&](Core core, auto&& push) {
+          const size_t k = core.segment;
+          const CurveSegment& segment = curve.segments_[k];
+          // The samples of [a, b), and the segment's last with its last core: the cores tile them.
+          const double *begin = t.data(), *end = t.data() + t.size();
+          const Eigen::Index inside =
+              (core.b == segment.end ? std::upper_bound(begin, end, core.b) : std::lower_bound(begin, end, core.b)) -
+              std::lower_bound(begin, end, core.a);
+          std::optional<CurveWindow> window = FitCore(fitter, t, segment, options, std::move(core), push);
+          if (!window) return;
+          const std::lock_guard<std::mutex> lock(windows_mutex);
+          windows[k].push_back(std::move(*window));
+          done += inside;
+          ReportProgress(options.progress, "fitting windows", done, fitted_count);
+        },
+        CoreOrder);
     for (size_t k = 0; k < windows.size(); ++k) {
       CurveSegment& segment = curve.segments_[k];
       segment.windows = std::move(windows[k]);
-      std::sort(segment.windows.begin(), segment.windows.end(),
-                [](const CurveWindow& x, const CurveWindow& y) { return x.core_begin < y.core_begin; });
+      std::sort(segment.windows.begin(), segment.windows.end(), [](const CurveWindow& x, const CurveWindow& y) {
+        return std::tie(x.core_begin, x.core_end) < std::tie(y.core_begin, y.core_end);
+      });
       RefineEnds(fitter, t, segment, options, threads);
     }
   }

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <vector>
 
 namespace cheval::cheb {
@@ -166,6 +167,7 @@ namespace internal {
 // noise estimate's time on long recordings.
 double SelectNonNegative(std::vector<double>* values, size_t k) {
   std::vector<double>& v = *values;
+  if (k >= v.size()) throw std::invalid_argument("SelectNonNegative: k beyond the values");
   constexpr size_t kFew = size_t{1} << 14;
   if (v.size() > kFew) {
     std::vector<uint32_t> counts(size_t{1} << 16);

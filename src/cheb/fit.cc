@@ -359,7 +359,7 @@ CHEVAL_MULTIVERSION Eigen::MatrixXd EvaluateSeries(const Eigen::Ref<const Eigen:
       }
       for (int p = 0; p < count; ++p) {
         const int v = p / kLanes, l = p % kLanes;
-        result(begin + p, c) = 0.5 * two_x[v][l] * b1[v][l] - b2[v][l] + a[0];
+        result(begin + p, c) = x[begin + p] * b1[v][l] - b2[v][l] + a[0];
       }
     }
   }

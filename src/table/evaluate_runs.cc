@@ -139,9 +139,10 @@ eval::EvaluationOptions BaseOptions(const Experiment& e, const RunSpec& run) {
   return o;
 }
 
-// One metric of a run in cheval mode.
+// One metric of a run in cheval mode; a reference's velocity is fitted on `fit_threads`
+// (CurveOptions::threads).
 double ChevalMetric(const Experiment& e, const RunSpec& run, SharedReference& ref, const traj::Trajectory& est,
-                    const std::string& metric) {
+                    const std::string& metric, int fit_threads) {
   eval::EvaluationOptions o = BaseOptions(e, run);
   static const std::regex rpe(R"(rpe_(trans|rot)_(.+)m)");
   std::smatch m;
@@ -163,6 +164,7 @@ double ChevalMetric(const Experiment& e, const RunSpec& run, SharedReference& re
         try {
           eval::VelocityOptions v = o.velocity;
           v.method = eval::VelocityMethod::kChebyshev;
+          v.curve.threads = fit_threads;
           const eval::VelocityEstimate fit = eval::EstimateVelocity(ref.trajectory.View(), v);
           ref.with_velocity = ref.trajectory;
           ref.with_velocity->SetVelocities(fit.velocities);
@@ -186,7 +188,7 @@ double ChevalMetric(const Experiment& e, const RunSpec& run, SharedReference& re
   return Statistic(eval::Evaluate(reference->View(), est.View(), o).stats, e.statistic);
 }
 
-RunResult EvaluateRun(const Experiment& e, const RunSpec& run, ReferenceCache& refs) {
+RunResult EvaluateRun(const Experiment& e, const RunSpec& run, ReferenceCache& refs, int fit_threads) {
   RunResult result;
   const size_t n = e.metrics.size();
   result.values.assign(n, std::nullopt);
@@ -227,7 +229,7 @@ RunResult EvaluateRun(const Experiment& e, const RunSpec& run, ReferenceCache& r
       const traj::Trajectory est = traj::ReadTrajectory(run.estimate);
       for (size_t k = 0; k < n; ++k) {
         try {
-          result.values[k] = ChevalMetric(e, run, *ref, est, e.metrics[k]);
+          result.values[k] = ChevalMetric(e, run, *ref, est, e.metrics[k], fit_threads);
         } catch (const InputError&) {
           throw;
         } catch (const Error& error) {
@@ -309,7 +311,8 @@ std::vector<RunResult> EvaluateRuns(const Experiment& e, const EvaluateRunsOptio
             }
           }
           if (!cached) {
-            r = EvaluateRun(e, run, refs);
+            // Runs on several threads fit on one each; a lone run fits on every core.
+            r = EvaluateRun(e, run, refs, options.threads > 1 ? 1 : 0);
             if (!cache_file.empty()) {
               nlohmann::json j;
               j["values"] = nlohmann::json::array();

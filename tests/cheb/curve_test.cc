@@ -473,8 +473,9 @@ TEST(CurveOptions, ValidateNamesEachBadField) {
   EXPECT_EQ(CurveOptionsError([](CurveOptions& o) { o.noise_sigma = 0.0; }), "valid");
   EXPECT_EQ(CurveOptionsError([](CurveOptions& o) { o.end_degree = -1; }),
             "end_degree must be non-negative (0: no end refinement), got -1");
-  EXPECT_EQ(CurveOptionsError([](CurveOptions& o) { o.threads = -1; }),
-            "threads must be non-negative (0: every core), got -1");
+  EXPECT_EQ(CurveOptionsError([](CurveOptions& o) { o.threads = -1; }), "threads must be in 0..256 (0: every core), got -1");
+  EXPECT_EQ(CurveOptionsError([](CurveOptions& o) { o.threads = 257; }),
+            "threads must be in 0..256 (0: every core), got 257");
   // The first bad field in declaration order is named.
   EXPECT_EQ(CurveOptionsError([](CurveOptions& o) {
               o.max_degree = 0;

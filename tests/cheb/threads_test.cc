@@ -7,8 +7,10 @@
 #include <limits>
 #include <mutex>
 #include <numeric>
+#include <utility>
 #include <random>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -31,17 +33,20 @@ TEST(DrainWork, ProcessesEveryItemAndEveryItemPushed) {
     std::mutex mutex;
     std::vector<int> leaves;
     std::atomic<int> processed{0};
-    internal::DrainWork(std::vector<Range>{{0, 1000}, {1000, 1037}}, threads, [&](Range r, auto&& push) {
-      ++processed;
-      if (r.b - r.a > 1) {
-        const int middle = (r.a + r.b) / 2;
-        push(Range{middle, r.b});
-        push(Range{r.a, middle});
-        return;
-      }
-      const std::lock_guard<std::mutex> lock(mutex);
-      leaves.push_back(r.a);
-    });
+    internal::DrainWork(
+        std::vector<Range>{{1000, 1037}, {0, 1000}}, threads,
+        [&](Range r, auto&& push) {
+          ++processed;
+          if (r.b - r.a > 1) {
+            const int middle = (r.a + r.b) / 2;
+            push(Range{middle, r.b});
+            push(Range{r.a, middle});
+            return;
+          }
+          const std::lock_guard<std::mutex> lock(mutex);
+          leaves.push_back(r.a);
+        },
+        [](const Range& r) { return std::pair(r.a, -r.b); });
     std::sort(leaves.begin(), leaves.end());
     std::vector<int> expected(1037);
     std::iota(expected.begin(), expected.end(), 0);
@@ -53,32 +58,59 @@ TEST(DrainWork, ProcessesEveryItemAndEveryItemPushed) {
 // On one thread the last pushed item is taken first: depth first, left before right as pushed.
 TEST(DrainWork, OneThreadTakesTheLastPushedFirst) {
   std::vector<int> order;
-  internal::DrainWork(std::vector<int>{1}, 1, [&](int item, auto&& push) {
-    order.push_back(item);
-    if (item < 4) {
-      push(2 * item + 1);
-      push(2 * item);
-    }
-  });
+  internal::DrainWork(
+      std::vector<int>{1}, 1,
+      [&](int item, auto&& push) {
+        order.push_back(item);
+        if (item < 4) {
+          push(2 * item + 1);
+          push(2 * item);
+        }
+      },
+      [](int item) { return item; });
   EXPECT_EQ(order, (std::vector<int>{1, 2, 4, 5, 3, 6, 7}));
 }
 
-// An exception in one item stops the others from taking more and reaches the caller once they
-// are done. Items take a millisecond, far longer than recording the exception: items taken last
-// first, the 50th throws and the rest are not taken.
-TEST(DrainWork, TheFirstExceptionIsRethrown) {
-  for (const int threads : {1, 3}) {
-    std::atomic<int> processed{0};
-    std::vector<int> items(200);
-    std::iota(items.begin(), items.end(), 0);
-    EXPECT_THROW(internal::DrainWork(items, threads,
-                                     [&](int item, auto&&) {
-                                       ++processed;
-                                       std::this_thread::sleep_for(std::chrono::milliseconds(1));
-                                       if (item == 150) throw std::runtime_error("item 150");
-                                     }),
-                 std::runtime_error);
-    EXPECT_LT(processed.load(), 100) << threads << " threads";
+// Items that throw: the exception rethrown is the one a single thread meets first (items taken
+// last first: 150 before 30), on any number of threads, however they are scheduled; items after
+// it are not taken. Items take a millisecond, far longer than recording an exception.
+TEST(DrainWork, TheExceptionOneThreadMeetsFirstIsRethrown) {
+  for (const int threads : {1, 2, 3, 5}) {
+    for (int repeat = 0; repeat < 5; ++repeat) {
+      std::atomic<int> processed{0};
+      std::vector<int> items(200);
+      std::iota(items.begin(), items.end(), 0);
+      try {
+        internal::DrainWork(
+            items, threads,
+            [&](int item, auto&&) {
+              ++processed;
+              std::this_thread::sleep_for(std::chrono::milliseconds(item == 30 ? 0 : 1));
+              if (item == 150 || item == 30) throw std::runtime_error("item " + std::to_string(item));
+            },
+            [](int item) { return -item; });
+        ADD_FAILURE() << "no exception";
+      } catch (const std::runtime_error& e) {
+        EXPECT_STREQ(e.what(), "item 150") << threads << " threads";
+      }
+      EXPECT_LT(processed.load(), 100) << threads << " threads";
+    }
+  }
+}
+
+// An index before the first one to throw still runs and, when it throws too, wins: index 2
+// throws after index 3 did.
+TEST(ParallelFor, RethrowsTheSmallestIndexThatThrew) {
+  for (const int threads : {1, 2, 4}) {
+    try {
+      internal::ParallelFor(8, threads, [](int i) {
+        if (i == 2) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        if (i >= 2) throw std::runtime_error("index " + std::to_string(i));
+      });
+      ADD_FAILURE() << "no exception";
+    } catch (const std::runtime_error& e) {
+      EXPECT_STREQ(e.what(), "index 2") << threads << " threads";
+    }
   }
 }
 
@@ -117,6 +149,8 @@ TEST(SelectNonNegative, FindsWhatNthElementFinds) {
   // Many equal values: every bucket the narrowing keeps holds them all.
   std::vector<double> equal(50000, 0.5);
   EXPECT_EQ(internal::SelectNonNegative(&equal, 25000), 0.5);
+  std::vector<double> few{1.0, 2.0};
+  EXPECT_THROW(internal::SelectNonNegative(&few, 2), std::invalid_argument);
 }
 
 // A recording with two gaps, a glitch, a step of the values and a burst of noise: four segments,
@@ -166,6 +200,8 @@ TEST(Threads, TheCurveIsTheSameForAnyNumber) {
         EXPECT_EQ(a[w].core_begin, b[w].core_begin);
         EXPECT_EQ(a[w].core_end, b[w].core_end);
         EXPECT_EQ(a[w].degrees, b[w].degrees);
+        ASSERT_EQ(a[w].series.coefficients.rows(), b[w].series.coefficients.rows());
+        ASSERT_EQ(a[w].series.coefficients.cols(), b[w].series.coefficients.cols());
         EXPECT_EQ(a[w].series.coefficients, b[w].series.coefficients);
         EXPECT_EQ(a[w].missed_motion, b[w].missed_motion);
       }
@@ -178,14 +214,16 @@ TEST(Threads, TheCurveIsTheSameForAnyNumber) {
     EXPECT_EQ(many.residual_rms(), one.residual_rms());
     Eigen::MatrixXd many_values, many_rates;
     many.EvaluateMany(stamps, 1, &many_values, &many_rates);
+    ASSERT_EQ(many_values.rows(), one_values.rows());
     EXPECT_EQ(many_values, one_values) << threads << " threads";
     EXPECT_EQ(many_rates, one_rates) << threads << " threads";
   }
 }
 
-// Progress comes from the fitting threads one call at a time: the samples done never fall, and
-// the stage ends with all of them.
-TEST(Threads, ProgressNeverFalls) {
+// Progress comes from the fitting threads one call at a time: a call that finds another under
+// way fails. The samples done never fall, stay below the total until the last window is fitted
+// (the cores tile the samples), and the stage ends with all of them.
+TEST(Threads, ProgressCallsNeverOverlapNorFall) {
   std::vector<int64_t> stamps;
   Eigen::MatrixXd values(20000, 1);
   for (Eigen::Index i = 0; i < values.rows(); ++i) {
@@ -193,17 +231,22 @@ TEST(Threads, ProgressNeverFalls) {
     values(i, 0) = std::sin(0.01 * static_cast<double>(i)) + 1e-4 * std::cos(1.3 * static_cast<double>(i));
   }
   std::vector<int64_t> done;
+  std::atomic<bool> inside{false};
   CurveOptions options;
-  options.threads = 2;
+  options.threads = 4;
   options.progress = [&](std::string_view stage, int64_t d, int64_t total) {
+    EXPECT_FALSE(inside.exchange(true)) << "two calls at once";
     EXPECT_EQ(stage, "fitting windows");
     EXPECT_EQ(total, 20000);
     done.push_back(d);
+    std::this_thread::sleep_for(std::chrono::microseconds(200));  // widen the window for an overlap
+    inside = false;
   };
   FitCurve(stamps, values, options);
-  ASSERT_GE(done.size(), 3u);
+  ASSERT_GE(done.size(), 4u);
   EXPECT_TRUE(std::is_sorted(done.begin(), done.end()));
   EXPECT_EQ(done.back(), 20000);
+  EXPECT_LT(done[done.size() - 3], 20000);  // before the last window and the stage's end
 }
 
 }  // namespace

@@ -91,7 +91,7 @@ TEST_F(LimitsCliTest, ZeroAndEmptyValuesAreRefusedNotIgnored) {
               "--window must be a positive number of seconds, got 0");
   ExpectFails("velocity " + Path("truth.txt") + " -o " + Path("out") + " --method savgol --window 0", 1, "--window");
   ExpectFails("velocity " + Path("truth.txt") + " -o " + Path("out") + " --threads -1", 1,
-              "--threads must be non-negative (0: every core), got -1");
+              "--threads must be in 0..256 (0: every core), got -1");
   ExpectFails("convert " + Path("truth.txt") + " -o " + Path("out") + " --columns ''", 1,
               "--columns: must name the columns");
   ExpectFails(Eval("ape") + "--est-columns '' --json " + Path("out"), 1, "--est-columns: must name the columns");

@@ -90,8 +90,11 @@ struct CurveOptions {
   /// regression"). Needs `lack_of_fit` and an adaptive fit. The angular fit turns it off: the
   /// charts' noise varies along them, and the choice relies on one σ.
   bool local_regression = true;
-  /// Threads that fit the windows of an adaptive fit; 0 = as many as the machine has. The curve is
-  /// the same for any number: windows are fitted independently and put in time order.
+  /// Threads for the fit where its work splits into independent parts (its windows, its two ends,
+  /// the noise estimate's orders, the jump search's passes; from 2,000 samples) and for
+  /// Curve::EvaluateMany; 0 = as many as the machine has, at most 256. The curve is the same for
+  /// any number, and so is the error of a fit that fails: each part computes what it would on one
+  /// thread, and the parts are put in order.
   int threads = 0;
   /// Told "fitting windows" with the samples fitted so far, as windows are accepted (may be empty;
   /// called from the fitting threads, one call at a time).
@@ -100,7 +103,7 @@ struct CurveOptions {
   /// Throws OptionError naming the first field out of range: fixed_degree < 0 (with kFixed),
   /// window_s not positive and finite, max_conditioning <= 0, max_degree < 1,
   /// min_window_samples < 2, overlap outside [0, 1], gap_factor <= 1, min_gap_s < 0, noise_sigma
-  /// negative or not finite, end_degree < 0, threads < 0.
+  /// negative or not finite, end_degree < 0, threads outside 0..256.
   void Validate() const;
 };
 
@@ -186,10 +189,11 @@ class Curve {
                         double tolerance_s = 0.0) const;
 
   /// Values (n x d) and, for order >= 1 and 2, first and second derivatives (n x d) at many stamps
-  /// (any order; row i belongs to stamps_ns[i]). The same numbers as the point-wise calls, several
-  /// times faster: the queries a window serves are evaluated together by vectorised Clenshaw, and
-  /// many queries are split over the threads the curve was fitted with (CurveOptions::threads; all
-  /// cores for a curve from FromParts).
+  /// (any order; row i belongs to stamps_ns[i]). The point-wise calls' numbers to rounding (where
+  /// the CPU fuses multiply-adds, the vectorised evaluation does), several times faster: the
+  /// queries a window serves are evaluated together by vectorised Clenshaw, and many queries are
+  /// split over the threads the curve was fitted with (CurveOptions::threads; all cores for a
+  /// curve from FromParts). Each query's numbers do not depend on that split.
   void EvaluateMany(std::span<const int64_t> stamps_ns, int order, Eigen::MatrixXd* values,
                     Eigen::MatrixXd* first = nullptr, Eigen::MatrixXd* second = nullptr,
                     double tolerance_s = 0.0) const;

@@ -12,8 +12,9 @@
 namespace cheval {
 
 /// Called with the stage's name (e.g. "fitting windows"), the units done so far and their total
-/// (0 when unknown), from the thread doing the work. A stage ends with done == total. Calls are
-/// cheap for the caller to make: at most a few hundred per stage.
+/// (0 when unknown), from the thread doing the work, which may be a thread the library started
+/// for it (never two calls at once; done never falls within a stage). A stage ends with
+/// done == total. Calls are cheap for the caller to make: at most a few hundred per stage.
 using ProgressFn = std::function<void(std::string_view stage, int64_t done, int64_t total)>;
 
 /// Calls `progress` when it is set.
