@@ -640,7 +640,7 @@ class WindowFitter {
 // Its two halves are fitted too, and it is split when they predict held-out samples better: their
 // cross-validated squared error per sample, relative to the window's own and averaged over the
 // coordinates, is below 1 (no σ is involved).
-// A window fitted without splitting, its held-out errors, and whether FitAdaptive may take it as
+// A window fitted without splitting, its held-out errors, and whether FitCore may take it as
 // the fit of its core (WindowFitter::Fit's `reusable`).
 struct HalfFit {
   CurveWindow window;
