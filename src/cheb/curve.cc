@@ -1083,12 +1083,13 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   }
 
   ReportProgress(options.progress, "fitting windows", 0, fitted_count);
+  const bool fixed_windows = options.single_window || options.window_s.has_value();  // else adaptive
   for (size_t k = 0; k + 1 < starts.size(); ++k) {
     CurveSegment& segment = curve.segments_.emplace_back();
     segment.begin = t[starts[k]];
     segment.end = t[starts[k + 1] - 1];
     segment.continues = at_jump[k] != 0;
-    if (!options.single_window && !options.window_s) continue;
+    if (!fixed_windows) continue;
     const int cores = options.single_window
                           ? 1
                           : std::max(1, static_cast<int>(std::lround((segment.end - segment.begin) / *options.window_s)));
@@ -1098,7 +1099,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
       segment.windows.push_back(*fitter.Fit(a, b, segment.begin, segment.end, false));
     }
   }
-  if (!options.single_window && !options.window_s) {
+  if (!fixed_windows) {
     // The cores of all segments are fitted on the threads; each thread's windows wait under the
     // lock in their segment and are put in time order once all are fitted.
     std::vector<Core> roots;
@@ -1136,7 +1137,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     }
   }
 
-  const bool adaptive = !options.single_window && !options.window_s && options.degree_method != DegreeMethod::kFixed;
+  const bool adaptive = !fixed_windows && options.degree_method != DegreeMethod::kFixed;
   std::vector<int64_t> sorted;  // the fitted samples' stamps
   sorted.reserve(static_cast<size_t>(fitted_count));
   for (Eigen::Index i = 0; i < m; ++i) {
@@ -1452,7 +1453,7 @@ void Curve::EvaluateMany(std::span<const int64_t> stamps_ns, int order, Eigen::M
   // Many queries are split into one contiguous part per thread: each query's numbers are the same
   // however they are split.
   const int parts = n >= kParallelQueries ? internal::ThreadCount(threads_) : 1;
-  internal::ParallelFor(parts, parts, [&](int part) { evaluate(n * part / parts, n * (part + 1) / parts); });
+  internal::ParallelRanges(n, parts, evaluate);
 }
 
 Curve Curve::FromParts(int64_t origin_ns, std::vector<CurveSegment> segments, Eigen::VectorXd noise_sigma,

@@ -108,8 +108,8 @@ class SlopeScan {
   // On up to `threads` threads, each taking a contiguous part.
   Eigen::MatrixXd Departures(int threads) const {
     Eigen::MatrixXd departures = Eigen::MatrixXd::Constant(n_, d_, std::numeric_limits<double>::quiet_NaN());
-    ParallelFor(threads, threads, [&](int part) {
-      for (Eigen::Index j = n_ * part / threads; j < n_ * (part + 1) / threads; ++j) {
+    ParallelRanges(n_, threads, [&](Eigen::Index first, Eigen::Index last) {
+      for (Eigen::Index j = first; j < last; ++j) {
         if (!Usable(j)) continue;
         if (const std::optional<Point> e = Departure(j)) departures.row(j) = e->transpose();
       }
@@ -140,9 +140,9 @@ class SlopeScan {
   Eigen::MatrixXd Scales(const Eigen::MatrixXd& departures, int threads) const {
     const Eigen::Index blocks = (n_ + kBlock - 1) / kBlock;
     Eigen::MatrixXd median = Eigen::MatrixXd::Zero(blocks, d_);
-    ParallelFor(threads, threads, [&](int part) {
+    ParallelRanges(blocks, threads, [&](Eigen::Index first, Eigen::Index last) {
       std::vector<std::vector<double>> values(static_cast<size_t>(d_));
-      for (Eigen::Index b = blocks * part / threads; b < blocks * (part + 1) / threads; ++b) {
+      for (Eigen::Index b = first; b < last; ++b) {
         for (auto& v : values) v.clear();
         for (Eigen::Index j = b * kBlock; j < std::min(n_, (b + 1) * kBlock); ++j) {
           if (std::isnan(departures(j, 0))) continue;

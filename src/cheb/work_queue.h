@@ -11,6 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/Core>
+
 namespace cheval::cheb::internal {
 
 /// The most threads a `threads` option may ask for (CurveOptions::Validate).
@@ -113,6 +115,13 @@ void ParallelFor(int count, int threads, F&& f) {
   std::vector<int> items(static_cast<size_t>(std::max(count, 0)));
   for (int i = 0; i < count; ++i) items[static_cast<size_t>(count - 1 - i)] = i;  // 0 is taken first
   DrainWork(std::move(items), std::min(threads, count), [&f](int i, auto&&) { f(i); }, [](int i) { return i; });
+}
+
+/// Calls f(begin, end) on `parts` contiguous ranges that tile [0, count), on as many threads (the
+/// caller's among them); exceptions as ParallelFor, the first range first.
+template <typename F>
+void ParallelRanges(Eigen::Index count, int parts, F&& f) {
+  ParallelFor(parts, parts, [&](int part) { f(count * part / parts, count * (part + 1) / parts); });
 }
 
 }  // namespace cheval::cheb::internal
