@@ -20,10 +20,20 @@ namespace {
 // Half-widths (samples on either side) of the candidate regressions: 7 to 53 samples.
 constexpr std::array<int, 12> kHalves{3, 4, 5, 6, 7, 9, 11, 13, 16, 19, 22, 26};
 constexpr int kMaxDegree = 7;
-// The pilot (degree 7 over 15 samples: little bias) and the narrower fit its bias is judged against.
-constexpr int kPilotHalf = 7, kBiasHalf = 5;
 // A regression needs this many samples more than its coefficients.
 constexpr int kSpareSamples = 3;
+// A pilot of the rates and the fit its bias is judged against: half-widths (in kHalves) and
+// degrees. The first, degree 7 over 15 samples, has little noise (0.18·σ²/h² at even spacing) and
+// little bias up to a tenth of the rate (3 % at an eighth), but misses motion at a quarter of the
+// rate whole; the second is the 9-point stencil's rate (degree 7 through 9 samples: 3 % of a
+// tone's rate lost at a quarter of the rate, noise 1.36·σ²/h²), judged against the 7-point one's
+// (6.6 %). The second is taken only where the first's bias vetoes a candidate (StretchScores::Choose).
+struct Pilot {
+  int half, degree, reference_half, reference_degree;
+};
+constexpr std::array<Pilot, 2> kPilots{{{7, 7, 5, 7}, {4, 7, 3, 5}}};
+// Spare samples of a pilot or reference: the stencils above have one.
+constexpr int kPilotSpareSamples = 1;
 // A candidate replaces the windows only when its estimated gain is this many standard errors.
 constexpr double kSignificance = 2.0;
 // The pilot's bias estimate is discounted by its standard errors only where the noise share it
@@ -99,11 +109,12 @@ class LocalFits {
     return {lo, lo + 2 * half};
   }
 
-  // The regression of degree `degree` over half-width kHalves[h].
-  Regression Fit(size_t h, int degree) const {
+  // The regression of degree `degree` over half-width kHalves[h], with at least `spare` samples
+  // more than its coefficients.
+  Regression Fit(size_t h, int degree, int spare = kSpareSamples) const {
     Regression r;
     r.lo = lo_[h], r.hi = hi_[h];
-    if (r.hi - r.lo + 1 < degree + 1 + kSpareSamples) return r;
+    if (r.hi - r.lo + 1 < degree + 1 + spare) return r;
     const double ti = t_[i_];
     r.scale = std::max(t_[r.hi] - ti, ti - t_[r.lo]);
     if (!(r.scale > 0.0)) return r;
@@ -257,8 +268,13 @@ struct StretchScores {
     return {mean, std::sqrt(std::max(0.0, sum_squares / count - mean * mean) / (count - 1.0))};
   }
 
-  // The candidate that replaces the windows in coordinate c (noise σ), or -1.
-  int Choose(Eigen::Index c, double sigma) const {
+  // The candidate that replaces the windows in coordinate c (noise σ), or -1; and whether the
+  // pilot's bias alone kept the best candidate out.
+  struct Choice {
+    int candidate = -1;
+    bool biased_pilot = false;
+  };
+  Choice Choose(Eigen::Index c, double sigma) const {
     // The windows' rates differ from the pilot's by at least their noise, σ²·Σ|w_W − w_P|² in
     // expectation: where they differ less, σ overstates the noise there (motion taken for noise,
     // e.g. a noise-free tremor), and the smaller value follows from the differences.
@@ -267,7 +283,7 @@ struct StretchScores {
         data_variance, window_spread[c] > 0.0 ? window_differences[c] / window_spread[c] : data_variance);
     // Windows closer to the pilot than a fraction of that: nothing here tells the pilot's bias
     // from noise, and the windows are kept.
-    if (variance < kSmoothFraction * data_variance) return -1;
+    if (variance < kSmoothFraction * data_variance) return {};
     int chosen = -1;
     double best = std::numeric_limits<double>::infinity();
     for (Eigen::Index a = 0; a < differences.rows(); ++a) {
@@ -294,11 +310,12 @@ struct StretchScores {
     const double discount = noise_total < kBiasNoiseShare * differences_total ? 0.0 : kSignificance * bias_error;
     const double bias = static_cast<double>(length) * std::max(0.0, bias_mean - discount);
     const double windows_score = window_differences[c] + 2.0 * variance * window_products[c];
-    if (chosen < 0 || !(best + 2.0 * bias < windows_score)) return -1;
+    if (chosen < 0) return {};
+    if (!(best + 2.0 * bias < windows_score)) return {.biased_pilot = bias > 0.0};
     // The gain must stand out of its own scatter: 2 standard errors of the mean of the blocks'.
     const auto [mean, error] = MeanAndError(
         [&](size_t b) { return block_gains[b](chosen, c) + 2.0 * variance * block_products[b](chosen, c); });
-    return mean < -kSignificance * error ? chosen : -1;
+    return {.candidate = mean < -kSignificance * error ? chosen : -1};
   }
 
   Eigen::Index length, blocks;
@@ -345,7 +362,6 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
   const auto zs = z.middleRows(first, n);
   const std::vector<std::pair<size_t, int>> candidates = Candidates();
   const auto count = static_cast<Eigen::Index>(candidates.size());
-  const size_t pilot_h = HalfIndex(kPilotHalf), bias_h = HalfIndex(kBiasHalf);
   std::vector<std::optional<WindowWeights>> window_weights(windows.size());
 
   for (Eigen::Index s0 = 0; s0 < n;) {
@@ -366,53 +382,68 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
     // 720k-sample drone flight has stretches of 315k samples, which took a minute to score).
     const Eigen::Index stretch_blocks = length / kBlock;
     const bool sampled = stretch_blocks > kMaxScoredBlocks;
-    StretchScores scores(count, d, sampled ? kMaxScoredBlocks * kBlock : length);
     std::vector<Eigen::Index> scored;  // the samples scored, in order
     for (Eigen::Index b = 0; b < (sampled ? kMaxScoredBlocks : 1); ++b) {
       const Eigen::Index begin = sampled ? s0 + b * stretch_blocks / kMaxScoredBlocks * kBlock : s0;
       for (Eigen::Index i = begin; i < (sampled ? begin + kBlock : s1); ++i) scored.push_back(i);
     }
-    Eigen::VectorXd norm(d);
-    for (size_t q = 0; q < scored.size(); ++q) {
-      const Eigen::Index i = scored[q];
-      const LocalFits fits(ts, zs, i);
-      const Regression pilot = fits.Fit(pilot_h, kMaxDegree);
-      const Regression reference = fits.Fit(bias_h, kMaxDegree);
-      if (!pilot.ok || !reference.ok) return runs;
-      const double ti = ts[i];
-      const auto block = static_cast<size_t>(std::min(scores.blocks - 1, static_cast<Eigen::Index>(q) / kBlock));
-      scores.block_bias_differences[block] += (pilot.rate - reference.rate).cwiseAbs2();
-      scores.block_bias_variance[block] +=
-          WeightNorm(pilot) - 2.0 * WeightProduct(ts, ti, pilot, reference) + WeightNorm(reference);
-      const auto k = static_cast<size_t>(owner[static_cast<size_t>(i)]);
-      if (!window_weights[k]) window_weights[k].emplace(t, z, windows[k]);
-      const Eigen::VectorXd window_difference = (fit_rates.row(first + i).transpose() - pilot.rate).cwiseAbs2();
-      const Eigen::VectorXd product = window_weights[k]->Product(ts, ti, pilot, &norm);
-      scores.window_differences += window_difference;
-      scores.window_products += product;
-      scores.window_spread += ((norm - 2.0 * product).array() + WeightNorm(pilot)).matrix();
-      for (Eigen::Index a = 0; a < count; ++a) {
-        const auto [h, degree] = candidates[static_cast<size_t>(a)];
-        const Regression r = fits.Fit(h, degree);
-        if (!r.ok) {
-          scores.usable[static_cast<size_t>(a)] = 0;
-          continue;
+    // The stretch's scores against one pilot (none where the pilot cannot be fitted).
+    auto score = [&](const Pilot& choice) -> std::optional<StretchScores> {
+      const size_t pilot_h = HalfIndex(choice.half), reference_h = HalfIndex(choice.reference_half);
+      StretchScores scores(count, d, static_cast<Eigen::Index>(scored.size()));
+      Eigen::VectorXd norm(d);
+      for (size_t q = 0; q < scored.size(); ++q) {
+        const Eigen::Index i = scored[q];
+        const LocalFits fits(ts, zs, i);
+        const Regression pilot = fits.Fit(pilot_h, choice.degree, kPilotSpareSamples);
+        const Regression reference = fits.Fit(reference_h, choice.reference_degree, kPilotSpareSamples);
+        if (!pilot.ok || !reference.ok) return std::nullopt;
+        const double ti = ts[i];
+        const auto block = static_cast<size_t>(std::min(scores.blocks - 1, static_cast<Eigen::Index>(q) / kBlock));
+        scores.block_bias_differences[block] += (pilot.rate - reference.rate).cwiseAbs2();
+        scores.block_bias_variance[block] +=
+            WeightNorm(pilot) - 2.0 * WeightProduct(ts, ti, pilot, reference) + WeightNorm(reference);
+        const auto k = static_cast<size_t>(owner[static_cast<size_t>(i)]);
+        if (!window_weights[k]) window_weights[k].emplace(t, z, windows[k]);
+        const Eigen::VectorXd window_difference = (fit_rates.row(first + i).transpose() - pilot.rate).cwiseAbs2();
+        const Eigen::VectorXd product = window_weights[k]->Product(ts, ti, pilot, &norm);
+        scores.window_differences += window_difference;
+        scores.window_products += product;
+        scores.window_spread += ((norm - 2.0 * product).array() + WeightNorm(pilot)).matrix();
+        for (Eigen::Index a = 0; a < count; ++a) {
+          const auto [h, degree] = candidates[static_cast<size_t>(a)];
+          const Regression r = fits.Fit(h, degree);
+          if (!r.ok) {
+            scores.usable[static_cast<size_t>(a)] = 0;
+            continue;
+          }
+          const Eigen::VectorXd difference = (r.rate - pilot.rate).cwiseAbs2();
+          const double weight_product = WeightProduct(ts, ti, r, pilot);
+          scores.differences.row(a) += difference.transpose();
+          scores.products[a] += weight_product;
+          scores.block_gains[block].row(a) += (difference - window_difference).transpose();
+          scores.block_products[block].row(a) += (weight_product - product.array()).matrix().transpose();
         }
-        const Eigen::VectorXd difference = (r.rate - pilot.rate).cwiseAbs2();
-        const double weight_product = WeightProduct(ts, ti, r, pilot);
-        scores.differences.row(a) += difference.transpose();
-        scores.products[a] += weight_product;
-        scores.block_gains[block].row(a) += (difference - window_difference).transpose();
-        scores.block_products[block].row(a) += (weight_product - product.array()).matrix().transpose();
+      }
+      return scores;
+    };
+    // Per coordinate, the first pilot's choice; where its bias alone vetoes the best candidate
+    // (motion near a quarter of the rate, which it misses), the second's.
+    std::vector<int> chosen(static_cast<size_t>(d), -1);
+    std::vector<bool> biased(static_cast<size_t>(d), false);
+    const Eigen::VectorXd sigma = noise.Over(first + s0, length);
+    for (size_t rung = 0; rung < kPilots.size(); ++rung) {
+      if (rung > 0 && std::none_of(biased.begin(), biased.end(), [](bool b) { return b; })) break;
+      const std::optional<StretchScores> scores = score(kPilots[rung]);
+      if (!scores) break;
+      for (Eigen::Index c = 0; c < d; ++c) {
+        if (rung > 0 && !biased[static_cast<size_t>(c)]) continue;
+        const StretchScores::Choice choice = scores->Choose(c, sigma[c]);
+        chosen[static_cast<size_t>(c)] = choice.candidate;
+        biased[static_cast<size_t>(c)] = choice.biased_pilot;
       }
     }
-    std::vector<int> chosen(static_cast<size_t>(d), -1);
-    bool replaced = false;
-    const Eigen::VectorXd sigma = noise.Over(first + s0, length);
-    for (Eigen::Index c = 0; c < d; ++c) {
-      chosen[static_cast<size_t>(c)] = scores.Choose(c, sigma[c]);
-      replaced = replaced || chosen[static_cast<size_t>(c)] >= 0;
-    }
+    const bool replaced = std::any_of(chosen.begin(), chosen.end(), [](int a) { return a >= 0; });
     if (replaced) {
       // The run: the stretch and a sample of the fit on either side.
       const Eigen::Index begin = std::max<Eigen::Index>(0, s0 - 1), stop = std::min(n, s1 + 1);

@@ -31,7 +31,10 @@ bool RegressionMayGain(const CurveWindow& window);
 /// (their weights from each core window's normal matrix). The best candidate replaces the
 /// windows' rate in that coordinate when its score, plus twice the pilot's squared bias
 /// (estimated against degree 7 over 11 samples, less 2 standard errors of that estimate from
-/// the means of 53-sample blocks), is below the windows', its gain is at least 2
+/// the means of 53-sample blocks), is below the windows' — where that bias alone keeps the best
+/// candidate out (motion near a quarter of the rate, which a 15-sample pilot misses whole), the
+/// coordinate is scored again against the 9-point stencil's rate, its bias judged against the
+/// 7-point one's —, its gain is at least 2
 /// standard errors (from the means of 53-sample blocks; stretches of at least 4 blocks), and the
 /// windows' rates differ from the pilot's by at least a quarter of what σ implies (else σ
 /// overstates the noise and the windows are kept; σ² itself is the smaller of the data's and
