@@ -1185,22 +1185,39 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     }
   }
   // Where windows were split for missed motion, a local polynomial regression where it predicts
-  // the rate better (docs/velocity.md, "Local regression").
+  // the rate better than the windows or the local interpolant (docs/velocity.md, "Local
+  // regression"); the local interpolant's samples inside its runs are given over to it.
   if (options.lack_of_fit && options.local_regression && adaptive && RegressionMayGainSomewhere(curve.segments_)) {
     Eigen::MatrixXd fit_values, fit_rates;
     curve.EvaluateMany(sorted, 1, &fit_values, &fit_rates);
     for (Eigen::Index i = 0; i < fitted_count; ++i) {  // the fitted values without the steps, as z
       if (const Eigen::Index k = curve.StepsBefore(t[i]); k > 0) fit_values.row(i) -= curve.step_offsets_.row(k - 1);
     }
-    std::vector<LocalRun> added;
+    const bool local = !local_samples.empty();
+    std::vector<LocalRun> regression;
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
-      std::vector<LocalRun> runs = internal::LocalRegressionRuns(t, z, starts[k], starts[k + 1], curve.segments_[k],
-                                                                 fit_values, fit_rates, profile, curve.local_runs_);
-      std::move(runs.begin(), runs.end(), std::back_inserter(added));
+      std::vector<LocalRun> runs = internal::LocalRegressionRuns(
+          t, z, starts[k], starts[k + 1], curve.segments_[k], local ? window_values : fit_values,
+          local ? window_rates : fit_rates, fit_values, fit_rates, local ? &local_samples[k] : nullptr, profile);
+      if (local) {
+        const Eigen::Index n = starts[k + 1] - starts[k];
+        for (const LocalRun& run : runs) {
+          const auto [from, to] = internal::SamplesOf(t, starts[k], n, run);
+          if (to > from) local_samples[k].local.middleRows(from, to - from).setConstant(false);
+        }
+      }
+      std::move(runs.begin(), runs.end(), std::back_inserter(regression));
     }
-    std::move(added.begin(), added.end(), std::back_inserter(curve.local_runs_));
-    std::sort(curve.local_runs_.begin(), curve.local_runs_.end(),
-              [](const LocalRun& x, const LocalRun& y) { return x.times.front() < y.times.front(); });
+    if (!regression.empty()) {
+      std::vector<LocalRun> all = std::move(regression);
+      for (size_t k = 0; local && k + 1 < starts.size(); ++k) {
+        std::vector<LocalRun> built = internal::BuildLocalRuns(t, z, starts[k], starts[k + 1], local_samples[k],
+                                                               window_values, window_rates, profile);
+        std::move(built.begin(), built.end(), std::back_inserter(all));
+      }
+      std::sort(all.begin(), all.end(), [](const LocalRun& x, const LocalRun& y) { return x.times.front() < y.times.front(); });
+      curve.local_runs_ = std::move(all);
+    }
   }
 
   // Where an unresolved window's fit, or a local stencil chosen without the motion's frequency,

@@ -52,6 +52,12 @@ constexpr Eigen::Index kPooledWindows = 2;
 // pass the break-even: at the break-even the expected gain is nil, and of the hundreds of windows
 // tested, those that pass only by their mean's scatter lose (tests/cheb/under_resolved_test.cc).
 constexpr double kDepartureMargin = 1.0;
+// The most the mean squared difference of the 3-point and 5-point rates at local samples may exceed
+// the noise the two share by, as a factor, for the samples to be called noisy (NoisyLocalSamples).
+// At even spacing the 3-point rate's noise is 7.2 times the difference's (0.5 against 0.069·σ²/h²)
+// and its squared bias 1–3 times the difference's (b₃ ∝ ω², b₅ ∝ ω⁴; 3 at a quarter of the rate):
+// at 10 the noise is still a fifth of the 3-point rate's error, which a smoother may take away.
+constexpr double kNoisyLocalRates = 10.0;
 // Samples beyond the end sample in the one-sided stencil of higher order (BuildRuns), and the
 // largest ratio of its steps it is used over.
 constexpr Eigen::Index kOneSided = 5;
@@ -561,44 +567,52 @@ Eigen::VectorXd RateNoiseGains(const Eigen::VectorXd& t, const Eigen::MatrixXd& 
   return gains;
 }
 
+// The interpolating spline's weights at sample i (1 ≤ i ≤ n − 2) of a segment (from `first`, n
+// samples), on its samples p0 − 1 .. p1 + 1 (p0 = max(1, i − kSplineReach), p1 = min(n − 2, i +
+// kSplineReach)): the row of A⁻¹B at i for the tridiagonal system of its slopes (SplineSlopes),
+// A⁻ᵀe_i solved over kSplineReach samples on either side (its weights fall by 0.27 per sample at
+// even spacing: 4e-5 at the patch's edge, where the slopes are held).
+Eigen::VectorXd SplineWeights(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n, Eigen::Index i) {
+  const Eigen::Index p0 = std::max<Eigen::Index>(1, i - kSplineReach), p1 = std::min(n - 2, i + kSplineReach);
+  const Eigen::Index q = p1 - p0 + 1;
+  auto step = [&](Eigen::Index r) { return t[first + r + 1] - t[first + r]; };  // h_r: r to r + 1
+  // Aᵀy = e_i by Thomas' algorithm. Row r of A is h_r·s_{r−1} + 2(h_{r−1} + h_r)·s_r +
+  // h_{r−1}·s_{r+1}, so Aᵀ(r, r − 1) = A(r − 1, r) = h_{r−2} and Aᵀ(r, r + 1) = A(r + 1, r) = h_{r+1}.
+  Eigen::VectorXd lower(q), diagonal(q), upper(q), y = Eigen::VectorXd::Zero(q);
+  for (Eigen::Index r = 0; r < q; ++r) {
+    const Eigen::Index row = p0 + r;
+    diagonal[r] = 2.0 * (step(row - 1) + step(row));
+    lower[r] = r > 0 ? step(row - 2) : 0.0;
+    upper[r] = r + 1 < q ? step(row + 1) : 0.0;
+  }
+  y[i - p0] = 1.0;
+  for (Eigen::Index r = 1; r < q; ++r) {
+    const double factor = lower[r] / diagonal[r - 1];
+    diagonal[r] -= factor * upper[r - 1];
+    y[r] -= factor * y[r - 1];
+  }
+  y[q - 1] /= diagonal[q - 1];
+  for (Eigen::Index r = q - 2; r >= 0; --r) y[r] = (y[r] - upper[r] * y[r + 1]) / diagonal[r];
+  // w_s over samples p0 − 1 .. p1 + 1: row r of B is 3(h_r·d_{r−1} + h_{r−1}·d_r), d the slopes.
+  Eigen::VectorXd spline = Eigen::VectorXd::Zero(q + 2);
+  for (Eigen::Index r = 0; r < q; ++r) {
+    const Eigen::Index row = p0 + r;
+    const double before = step(row - 1), after = step(row);
+    spline[r] += y[r] * -3.0 * after / before;
+    spline[r + 1] += y[r] * 3.0 * (after / before - before / after);
+    spline[r + 2] += y[r] * 3.0 * before / after;
+  }
+  return spline;
+}
+
 // The noise products at sample i of a segment (from `first`, n samples) of the interpolating
-// spline's slopes with the candidate rates of ReviseLocalSamples, from their weights on the
-// samples: w_x·w_s for the 3-point rate, the 5-point one (where i has two samples on either side;
-// the 3-point one's otherwise) and the spline's (|w_s|²), and |w₅ − w_s|². The spline's weights are
-// the row of A⁻¹B at i for the tridiagonal system of its slopes (SplineSlopes), A⁻ᵀe_i solved over
-// kSplineReach samples on either side (its weights fall by 0.27 per sample at even spacing: 4e-5
-// at the patch's edge, where the slopes are held).
+// spline's slopes (SplineWeights) with the candidate rates of ReviseLocalSamples, from their
+// weights on the samples: w_x·w_s for the 3-point rate, the 5-point one (where i has two samples
+// on either side; the 3-point one's otherwise) and the spline's (|w_s|²), and |w₅ − w_s|².
 struct RateWeights {
   RateWeights(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n, Eigen::Index i) {
-    const Eigen::Index p0 = std::max<Eigen::Index>(1, i - kSplineReach), p1 = std::min(n - 2, i + kSplineReach);
-    const Eigen::Index q = p1 - p0 + 1;
-    auto step = [&](Eigen::Index r) { return t[first + r + 1] - t[first + r]; };  // h_r: r to r + 1
-    // Aᵀy = e_i by Thomas' algorithm. Row r of A is h_r·s_{r−1} + 2(h_{r−1} + h_r)·s_r +
-    // h_{r−1}·s_{r+1}, so Aᵀ(r, r − 1) = A(r − 1, r) = h_{r−2} and Aᵀ(r, r + 1) = A(r + 1, r) = h_{r+1}.
-    Eigen::VectorXd lower(q), diagonal(q), upper(q), y = Eigen::VectorXd::Zero(q);
-    for (Eigen::Index r = 0; r < q; ++r) {
-      const Eigen::Index row = p0 + r;
-      diagonal[r] = 2.0 * (step(row - 1) + step(row));
-      lower[r] = r > 0 ? step(row - 2) : 0.0;
-      upper[r] = r + 1 < q ? step(row + 1) : 0.0;
-    }
-    y[i - p0] = 1.0;
-    for (Eigen::Index r = 1; r < q; ++r) {
-      const double factor = lower[r] / diagonal[r - 1];
-      diagonal[r] -= factor * upper[r - 1];
-      y[r] -= factor * y[r - 1];
-    }
-    y[q - 1] /= diagonal[q - 1];
-    for (Eigen::Index r = q - 2; r >= 0; --r) y[r] = (y[r] - upper[r] * y[r + 1]) / diagonal[r];
-    // w_s over samples p0 − 1 .. p1 + 1: row r of B is 3(h_r·d_{r−1} + h_{r−1}·d_r), d the slopes.
-    Eigen::VectorXd spline = Eigen::VectorXd::Zero(q + 2);
-    for (Eigen::Index r = 0; r < q; ++r) {
-      const Eigen::Index row = p0 + r;
-      const double before = step(row - 1), after = step(row);
-      spline[r] += y[r] * -3.0 * after / before;
-      spline[r + 1] += y[r] * 3.0 * (after / before - before / after);
-      spline[r + 2] += y[r] * 3.0 * before / after;
-    }
+    const Eigen::Index p0 = std::max<Eigen::Index>(1, i - kSplineReach);
+    const Eigen::VectorXd spline = SplineWeights(t, first, n, i);
     spline_norm = spline.squaredNorm();
     // w·w_s for the weights of the polynomial through samples i − half .. i + half (the 3-point
     // rate: CentredRate's; the 5-point one: LagrangeRate's), and |w|².
@@ -774,7 +788,8 @@ LocalSamples ChooseLocalSamples(const Eigen::VectorXd& t, Eigen::Index first, Ei
   const Eigen::Index n = last - first, d = fit_rates.cols();
   // Local samples and coordinates: in the core of a window that clearly missed motion there; and
   // those whose rate is the 5-point one, and the spline's (UnderResolvedRates).
-  LocalSamples chosen{Flags::Constant(n, d, false), Flags::Constant(n, d, false), Flags::Constant(n, d, false)};
+  LocalSamples chosen{Flags::Constant(n, d, false), Flags::Constant(n, d, false), Flags::Constant(n, d, false),
+                      Flags::Constant(n, d, false)};
   if (n < 3 || segment.windows.empty()) return chosen;
   Flags& local = chosen.local;
   Flags& five = chosen.five;
@@ -803,6 +818,7 @@ LocalSamples ChooseLocalSamples(const Eigen::VectorXd& t, Eigen::Index first, Ei
                     rates.under_resolved(k, c);
       five(i, c) = rates.stencil(k, c) == 5;
       spline(i, c) = rates.stencil(k, c) == kSpline;
+      chosen.modelled(i, c) = local(i, c) && rates.modelled(k, c);
     }
   }
   return chosen;
@@ -959,6 +975,38 @@ bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eige
     }
   }
   return changed;
+}
+
+std::vector<char> NoisyLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index n,
+                                    const LocalSamples& chosen, const NoiseProfile& noise) {
+  const Eigen::Index d = z.cols();
+  Eigen::VectorXd differences = Eigen::VectorXd::Zero(d), noise_share = Eigen::VectorXd::Zero(d);
+  for (Eigen::Index i = 2; i + 2 < n; ++i) {
+    if (!chosen.local.row(i).any()) continue;
+    const Eigen::VectorXd three = LagrangeWeights(t, first + i, first + i - 1, first + i + 1);
+    Eigen::VectorXd difference = LagrangeWeights(t, first + i, first + i - 2, first + i + 2);
+    difference.segment(1, 3) -= three;
+    const Eigen::VectorXd sigma = noise.Over(first + i, 1);
+    for (Eigen::Index c = 0; c < d; ++c) {
+      if (!chosen.local(i, c)) continue;
+      const double rate = difference.dot(z.col(c).segment(first + i - 2, 5));
+      differences[c] += rate * rate;
+      noise_share[c] += sigma[c] * sigma[c] * difference.squaredNorm();
+    }
+  }
+  std::vector<char> noisy(static_cast<size_t>(d), 0);
+  for (Eigen::Index c = 0; c < d; ++c) noisy[static_cast<size_t>(c)] = differences[c] > 0.0 && differences[c] <= kNoisyLocalRates * noise_share[c];
+  return noisy;
+}
+
+std::pair<Eigen::Index, Eigen::VectorXd> LocalRateWeights(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
+                                                          const LocalSamples& chosen, Eigen::Index i, Eigen::Index c) {
+  if (chosen.spline(i, c) && i >= 1 && i + 2 <= n - 1) {
+    return {std::max<Eigen::Index>(1, i - kSplineReach) - 1, SplineWeights(t, first, n, i)};
+  }
+  const Eigen::Index half = chosen.five(i, c) && i >= 2 && i + 2 < n ? 2 : 1;
+  const Eigen::Index lo = std::max<Eigen::Index>(0, std::min(i - half, n - 1 - 2 * half));
+  return {lo, LagrangeWeights(t, first + i, first + lo, first + lo + 2 * half)};
 }
 
 }  // namespace cheval::cheb::internal

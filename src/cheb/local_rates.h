@@ -68,10 +68,11 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
                               Eigen::Index last, const CurveSegment& segment, const NoiseProfile& noise);
 
 /// Per sample of a segment (rows) and coordinate (columns): whether the curve follows the sample
-/// there (`local`), and whether its rate is then the 5-point one (`five`) or the spline's slopes
-/// (`spline`) instead of the 3-point one.
+/// there (`local`), whether its rate is then the 5-point one (`five`) or the spline's slopes
+/// (`spline`) instead of the 3-point one, and whether that stencil was chosen knowing the motion's
+/// frequency (`modelled`: the held-out errors' orders fell, LocalRates::modelled).
 struct LocalSamples {
-  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> local, five, spline;
+  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> local, five, spline, modelled;
 };
 
 /// The local samples of one segment. A sample is local in coordinate c when it lies in the core of
@@ -122,6 +123,22 @@ LocalSamples ChooseLocalSamples(const Eigen::VectorXd& t, Eigen::Index first, Ei
 std::vector<LocalRun> BuildLocalRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                      Eigen::Index last, const LocalSamples& chosen, const Eigen::MatrixXd& fit_values,
                                      const Eigen::MatrixXd& fit_rates, const NoiseProfile& noise);
+
+/// The weights on the samples of the local rate `chosen` gives sample i of a segment (n samples
+/// from `first` in the sorted stamps `t`) in coordinate c — the 3-point rate's, the 5-point one's or
+/// the spline's slopes' — and the segment's sample the first weight is on. The substitutions beside
+/// close steps and spikes (BuildLocalRuns) are not followed: the weights serve to compare the
+/// noise of rates, to which a few such samples add little.
+std::pair<Eigen::Index, Eigen::VectorXd> LocalRateWeights(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
+                                                          const LocalSamples& chosen, Eigen::Index i, Eigen::Index c);
+
+/// Per coordinate, whether the local interpolant's samples of a segment (n samples from `first` in
+/// the sorted stamps `t` and values `z`) carry mostly noise: over them, the mean squared difference
+/// of the 3-point and 5-point rates is at most twice the noise the two share, σ²·|w₃ − w₅|² (σ
+/// the noise profile's). Where it is more, their biases differ: the samples' rates carry motion
+/// (as a filter's output does, sample to sample) that a smoother would take away.
+std::vector<char> NoisyLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index n,
+                                    const LocalSamples& chosen, const NoiseProfile& noise);
 
 /// Revises a segment's `chosen` local samples after the local regression (`regression`: its runs,
 /// whose samples it leaves). Per unresolved window and coordinate, pooled with kPooledGainWindows

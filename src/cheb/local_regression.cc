@@ -337,23 +337,34 @@ bool RegressionMayGain(const CurveWindow& window) {
 
 std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                           Eigen::Index last, const CurveSegment& segment,
+                                          const Eigen::MatrixXd& window_values, const Eigen::MatrixXd& window_rates,
                                           const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
-                                          const NoiseProfile& noise, const std::vector<LocalRun>& taken) {
+                                          const LocalSamples* local, const NoiseProfile& noise) {
   std::vector<LocalRun> runs;
   const std::vector<CurveWindow>& windows = segment.windows;
   const Eigen::Index n = last - first, d = z.cols();
   if (windows.size() < 3 || n < 2 * kHalves.back() + 1) return runs;
   // Candidate samples and the window whose core holds each: not in a segment's first or last
-  // window, nor inside a run taken already.
+  // window. Samples the local interpolant took are candidates too, scored with its rate.
   std::vector<int> owner(static_cast<size_t>(n), -1);
   const std::vector<Eigen::Index> windows_of = SampleWindows(t, first, n, windows);
   for (Eigen::Index i = 0; i < n; ++i) {
     const auto w = static_cast<size_t>(windows_of[static_cast<size_t>(i)]);
     if (w > 0 && w + 1 < windows.size() && RegressionMayGain(windows[w])) owner[static_cast<size_t>(i)] = static_cast<int>(w);
+    // A local rate chosen knowing the motion's frequency stays: σ then holds motion read as noise
+    // (noise-free tones at a quarter of the rate read as 0.2 mm), which would score the noise of
+    // the candidates' weights, not the rates' errors.
+    if (local && local->modelled.row(i).any()) owner[static_cast<size_t>(i)] = -1;
   }
-  for (const LocalRun& run : taken) {
-    const auto [from, to] = SamplesOf(t, first, n, run);
-    for (auto i = from; i < to; ++i) owner[static_cast<size_t>(i)] = -1;
+  // Nor does one in a coordinate whose local samples carry motion rather than noise (EuRoC's
+  // ground truth, a filter's output, has its vibration from sample to sample).
+  if (local) {
+    const std::vector<char> noisy = NoisyLocalSamples(t, z, first, n, *local, noise);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      for (Eigen::Index c = 0; c < d; ++c) {
+        if (local->local(i, c) && !noisy[static_cast<size_t>(c)]) owner[static_cast<size_t>(i)] = -1;
+      }
+    }
   }
   const bool any = std::any_of(owner.begin(), owner.end(), [](int w) { return w >= 0; });
   if (!any) return runs;
@@ -404,9 +415,22 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
         scores.block_bias_variance[block] +=
             WeightNorm(pilot) - 2.0 * WeightProduct(ts, ti, pilot, reference) + WeightNorm(reference);
         const auto k = static_cast<size_t>(owner[static_cast<size_t>(i)]);
-        if (!window_weights[k]) window_weights[k].emplace(t, z, windows[k]);
         const Eigen::VectorXd window_difference = (fit_rates.row(first + i).transpose() - pilot.rate).cwiseAbs2();
-        const Eigen::VectorXd product = window_weights[k]->Product(ts, ti, pilot, &norm);
+        Eigen::VectorXd product = Eigen::VectorXd::Zero(d);
+        if (!local || !local->local.row(i).all()) {  // the window's weights, where some coordinate has its rate
+          if (!window_weights[k]) window_weights[k].emplace(t, z, windows[k]);
+          product = window_weights[k]->Product(ts, ti, pilot, &norm);
+        }
+        for (Eigen::Index c = 0; local && c < d; ++c) {  // a local rate's weights instead of the window's
+          if (!local->local(i, c)) continue;
+          const auto [lo, weights] = LocalRateWeights(t, first, n, *local, i, c);
+          double sum = 0.0;
+          for (Eigen::Index j = std::max(lo, pilot.lo); j <= std::min(lo + weights.size() - 1, pilot.hi); ++j) {
+            sum += weights[j - lo] * pilot.Weight(ts[j], ti);
+          }
+          product[c] = sum;
+          norm[c] = weights.squaredNorm();
+        }
         scores.window_differences += window_difference;
         scores.window_products += product;
         scores.window_spread += ((norm - 2.0 * product).array() + WeightNorm(pilot)).matrix();
@@ -455,8 +479,9 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
         if (!run.times.empty() && !(ts[i] > run.times.back())) continue;
         const auto r = static_cast<Eigen::Index>(run.times.size());
         run.times.push_back(ts[i]);
-        run.values.row(r) = fit_values.row(first + i);
-        run.rates.row(r) = fit_rates.row(first + i);
+        const bool inside = i >= s0 && i < s1;  // its ends carry the windows' fit, as the local runs' do
+        run.values.row(r) = (inside ? fit_values : window_values).row(first + i);
+        run.rates.row(r) = (inside ? fit_rates : window_rates).row(first + i);
         if (i < s0 || i >= s1) continue;
         const LocalFits fits(ts, zs, i);
         for (Eigen::Index c = 0; c < d; ++c) {

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include "cheval/cheb/curve.h"
+#include "local_rates.h"
 
 namespace cheval::cheb::internal {
 
@@ -21,32 +22,36 @@ class NoiseProfile;
 bool RegressionMayGain(const CurveWindow& window);
 
 /// The local-regression runs of one segment. Candidates are stretches of consecutive samples in
-/// the cores of windows where RegressionMayGain, the segment's first
-/// and last window left out (the end caps' variance is not the window's) and samples inside
-/// `taken` (runs already made) too. Per stretch and coordinate, each local polynomial regression
-/// of odd degree 1–7 over 7–53 samples centred on each sample (shifted to stay inside the
-/// segment) is scored by its velocity error estimated against a pilot of little bias (degree 7
+/// the cores of windows where RegressionMayGain, the segment's first and last window left out (the
+/// end caps' variance is not the window's). Per stretch and coordinate, each local polynomial
+/// regression of odd degree 1–7 over 7–53 samples centred on each sample (shifted to stay inside
+/// the segment) is scored by its velocity error estimated against a pilot of little bias (degree 7
 /// over 15 samples), mean (v_a − v_P)² + 2σ²·w_a·w_P (w the rate's weights on the samples; the
-/// pilot's own σ²|w_P|² is common to every candidate and cancels), and so are the windows' rates
-/// (their weights from each core window's normal matrix). The best candidate replaces the
-/// windows' rate in that coordinate when its score, plus twice the pilot's squared bias
-/// (estimated against degree 7 over 11 samples, less 2 standard errors of that estimate from
-/// the means of 53-sample blocks), is below the windows' — where that bias alone keeps the best
-/// candidate out (motion near a quarter of the rate, which a 15-sample pilot misses whole), the
-/// coordinate is scored again against the 9-point stencil's rate, its bias judged against the
-/// 7-point one's —, its gain is at least 2
-/// standard errors (from the means of 53-sample blocks; stretches of at least 4 blocks), and the
-/// windows' rates differ from the pilot's by at least a quarter of what σ implies (else σ
-/// overstates the noise and the windows are kept; σ² itself is the smaller of the data's and
-/// what those differences imply). A run carries the regression's value and rate at the samples of the
-/// coordinates it replaces, the fit's elsewhere, and starts and ends on a sample of the fit.
+/// pilot's own σ²|w_P|² is common to every candidate and cancels), and so is the present rate (the
+/// windows', with their weights from each core window's normal matrix, or at the local
+/// interpolant's samples its stencil's, LocalRateWeights). The best candidate replaces the present
+/// rate in that coordinate when its score, plus twice the pilot's squared bias (estimated against
+/// degree 7 over 11 samples, less 2 standard errors of that estimate from the means of 53-sample
+/// blocks), is below the present rate's — where that bias alone keeps the best candidate out
+/// (motion near a quarter of the rate, which a 15-sample pilot misses whole), the coordinate is
+/// scored again against the 9-point stencil's rate, its bias judged against the 7-point one's —,
+/// its gain is at least 2 standard errors (from the means of 53-sample blocks; stretches of at
+/// least 4 blocks), and the present rates differ from the pilot's by at least a quarter of what σ
+/// implies (else σ overstates the noise and they are kept; σ² itself is the smaller of the data's
+/// and what those differences imply). A run carries the regression's value and rate at the
+/// samples of the coordinates it replaces, the present curve's elsewhere, and starts and ends on
+/// a sample of the windows' fit (the local interpolant's samples inside it are to be taken out of
+/// its runs).
 ///
 /// `t` (sorted, s) and `z` (m x d, steps taken out) are the curve's fitted samples, [first, last)
-/// the segment's, `fit_values` and `fit_rates` (m x d) the curve at them, `noise` the curve's noise
-/// profile (σ per stretch: its RMS over the stretch).
+/// the segment's, `window_values` and `window_rates` (m x d) the windows' fit at them,
+/// `fit_values` and `fit_rates` the present curve's (the local interpolant's where it took over),
+/// `local` the segment's local samples (none: the windows' fit throughout), `noise` the curve's
+/// noise profile (σ per stretch: its RMS over the stretch).
 std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                           Eigen::Index last, const CurveSegment& segment,
+                                          const Eigen::MatrixXd& window_values, const Eigen::MatrixXd& window_rates,
                                           const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
-                                          const NoiseProfile& noise, const std::vector<LocalRun>& taken);
+                                          const LocalSamples* local, const NoiseProfile& noise);
 
 }  // namespace cheval::cheb::internal

@@ -39,7 +39,8 @@ Samples Smooth(Eigen::Index m, uint64_t seed) {
 Eigen::VectorXd LocalRatesOf(const Samples& s) {
   const Eigen::Index m = s.t.size();
   using Flags = Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>;
-  const LocalSamples chosen{Flags::Constant(m, 1, true), Flags::Constant(m, 1, false), Flags::Constant(m, 1, false)};
+  const LocalSamples chosen{Flags::Constant(m, 1, true), Flags::Constant(m, 1, false), Flags::Constant(m, 1, false),
+                            Flags::Constant(m, 1, false)};
   const Eigen::MatrixXd fit = Eigen::MatrixXd::Zero(m, 1);
   const std::vector<LocalRun> runs =
       BuildLocalRuns(s.t, s.z, 0, m, chosen, fit, fit, NoiseProfile(Eigen::VectorXd::Constant(1, kNoise)));
@@ -80,6 +81,33 @@ TEST(LocalRates, ASmallStepLeavesOnlyItsSlope) {
       EXPECT_LT(std::abs(rates[i] - s.rate(i, 0)), 0.1 * kStep * kRate) << "seed " << seed << ", sample " << i - after;
     }
   }
+}
+
+// The local regression scores the local interpolant's samples only where their rates carry
+// noise enough (NoisyLocalSamples): white noise, or a tone at a quarter of the rate under noise of
+// its amplitude, does; a tone without noise whose 3-point and 5-point rates differ by their biases
+// (36 % and 15 % of its rate) far more than σ allows does not (σ a tenth of its amplitude, or its
+// amplitude ten times σ: a filter's output carrying its motion from sample to sample).
+TEST(LocalRates, OnlyNoisyLocalSamplesAreCalledNoisy) {
+  using Flags = Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>;
+  constexpr Eigen::Index m = 400;
+  const LocalSamples all{Flags::Constant(m, 1, true), Flags::Constant(m, 1, false), Flags::Constant(m, 1, false),
+                         Flags::Constant(m, 1, false)};
+  auto noisy = [&](double amplitude, double noise, double sigma) {
+    std::mt19937_64 rng(3);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    Eigen::VectorXd t(m);
+    Eigen::MatrixXd z(m, 1);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      t[i] = static_cast<double>(i) / kRate;
+      z(i, 0) = amplitude * std::sin(2.0 * M_PI * kRate / 4.0 * t[i] + 0.3) + noise * gauss(rng);
+    }
+    return NoisyLocalSamples(t, z, 0, m, all, NoiseProfile(Eigen::VectorXd::Constant(1, sigma)))[0] != 0;
+  };
+  EXPECT_TRUE(noisy(0.0, kNoise, kNoise));
+  EXPECT_TRUE(noisy(kNoise, kNoise, kNoise));
+  EXPECT_FALSE(noisy(kNoise, 0.0, kNoise / 10.0));
+  EXPECT_FALSE(noisy(10.0 * kNoise, 0.0, kNoise));
 }
 
 }  // namespace

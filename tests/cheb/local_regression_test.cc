@@ -189,23 +189,21 @@ TEST(LocalRegression, NoiseFreeMotionKeepsWindowsBetterThanThePilot) {
 // Tones up to a quarter of the rate under noise (the sweep's "tones fast 50Hz 2mm" and "200Hz
 // 0.5mm", bench/velocity_sweep.py): the pilot of degree 7 over 15 samples misses a tone there
 // whole, and its bias vetoed every candidate, while the windows (~23 samples at degree 3–8) missed
-// the tone too. The 9-point stencil's rate misses 3 % of it; scored against that pilot, the
-// regression takes a cubic over 7 samples or a quintic over 9–11, as the oracle would. Seeds 1, 3
-// and 4 gain 10–25 %; on seed 2 the local interpolant's samples cut every stretch below 4 blocks
-// and nothing changes. Before, no seed changed.
+// the tone too, and the local interpolant's rates carried the noise whole. The 9-point stencil's
+// rate misses 3 % of the tone; scored against that pilot, over the windows' samples and the local
+// interpolant's noisy ones, the regression takes a cubic over 7 samples or a quintic over 9–11, as
+// the oracle would: 0.71–0.82x the error without the regression on every seed. Before, no seed
+// gained (1.03–1.04x over the four).
 TEST(LocalRegression, TonesAtAQuarterOfTheRateAreScoredAgainstTheNineSampleStencil) {
   CurveOptions windows_only;
   windows_only.local_regression = false;
   for (const auto& [rate, noise] : {std::pair{50, 2e-3}, std::pair{200, 5e-4}}) {
-    double with_total = 0.0, without_total = 0.0;
     for (uint64_t seed = 1; seed <= 4; ++seed) {
       const Case c = MidBandTones(seed, rate, 0.25, noise);
       const double with = VelocityRmse(FitCurve(c.stamps, c.positions), c);
       const double without = VelocityRmse(FitCurve(c.stamps, c.positions, windows_only), c);
-      EXPECT_LE(with, 1.001 * without) << rate << " Hz, seed " << seed;
-      with_total += with, without_total += without;
+      EXPECT_LT(with, 0.85 * without) << rate << " Hz, seed " << seed << ": " << with / without << "x";
     }
-    EXPECT_LT(with_total, 0.9 * without_total) << rate << " Hz: " << with_total / without_total << "x the windows' error";
   }
 }
 

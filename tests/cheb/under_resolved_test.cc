@@ -42,7 +42,7 @@ double Rmse(const Eigen::MatrixXd& estimate, const Eigen::MatrixXd& truth) {
 }
 
 // Velocity RMSE of the fit and of central differences (one-sided at the ends).
-std::pair<double, double> Errors(const Tones& s, Eigen::Index* local_samples) {
+std::pair<double, double> Errors(const Tones& s, Eigen::Index* local_samples, Eigen::Index* regression_samples = nullptr) {
   const Curve curve = FitCurve(s.stamps, s.positions);
   Eigen::MatrixXd values, rates;
   curve.EvaluateMany(s.stamps, 1, &values, &rates);
@@ -53,6 +53,7 @@ std::pair<double, double> Errors(const Tones& s, Eigen::Index* local_samples) {
     central.row(i) = (s.positions.row(b) - s.positions.row(a)) / (static_cast<double>(s.stamps[b] - s.stamps[a]) * 1e-9);
   }
   *local_samples = curve.local_samples();
+  if (regression_samples) *regression_samples = curve.regression_samples();
   return {Rmse(rates, s.velocities), Rmse(central, s.velocities)};
 }
 
@@ -153,10 +154,9 @@ TEST(UnderResolved, NoiseIsNotTakenForUnderResolvedMotion) {
 // the windows' rate departs from the spline's slopes by more than the spline's noise allows, and
 // the samples' local rate takes over. Before, the windows smoothed the tones away: 1.50–1.80x
 // central differences' error; then 1.28–1.35x, with σ read 20 % high from the tones in the 4th
-// differences; now 1.12–1.18x, σ from the 8th differences (EstimateNoiseSigma). The rest: a third
-// of the samples stay with windows whose departure lies within its scatter, and central
-// differences lose 36 % of a tone's rate at a quarter of the rate, less than its noise costs the
-// spline.
+// differences; then 1.12–1.18x, σ from the 8th differences (EstimateNoiseSigma). The local rates
+// carry their noise whole; where they are noisy (NoisyLocalSamples), the local regression scores
+// them as it scores the windows and takes a smoother rate over most samples: 0.73–0.76x.
 TEST(UnderResolved, TonesNearAQuarterOfTheRateUnderNoiseFollowTheSamples) {
   for (const uint64_t seed : {1u, 2u, 3u}) {
     std::mt19937_64 rng(seed);
@@ -169,10 +169,10 @@ TEST(UnderResolved, TonesNearAQuarterOfTheRateUnderNoiseFollowTheSamples) {
         tones.push_back({c, hz, (0.1 + 0.1 * unit(rng)) / (2.0 * M_PI * hz), 2.0 * M_PI * unit(rng)});
       }
     }
-    Eigen::Index local = 0;
-    const auto [rmse, central] = Errors(Synthesize(100.0, tones, 0.5e-3, &rng), &local);
-    EXPECT_LT(rmse, 1.2 * central) << "seed " << seed << ": " << rmse << " m/s against central differences' " << central;
-    EXPECT_GT(local, 1000) << "seed " << seed;
+    Eigen::Index local = 0, regression = 0;
+    const auto [rmse, central] = Errors(Synthesize(100.0, tones, 0.5e-3, &rng), &local, &regression);
+    EXPECT_LT(rmse, 0.85 * central) << "seed " << seed << ": " << rmse << " m/s against central differences' " << central;
+    EXPECT_GT(local + regression, 1000) << "seed " << seed;
   }
 }
 
