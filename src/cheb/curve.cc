@@ -1194,11 +1194,17 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
       if (const Eigen::Index k = curve.StepsBefore(t[i]); k > 0) fit_values.row(i) -= curve.step_offsets_.row(k - 1);
     }
     const bool local = !local_samples.empty();
-    std::vector<LocalRun> regression;
-    for (size_t k = 0; k + 1 < starts.size(); ++k) {
-      std::vector<LocalRun> runs = internal::LocalRegressionRuns(
+    // The segments are independent: each on whichever thread takes it, the runs in segment order.
+    const auto segment_count = static_cast<int>(starts.size()) - 1;
+    std::vector<std::vector<LocalRun>> segment_runs(static_cast<size_t>(segment_count));
+    internal::ParallelFor(segment_count, threads, [&](int k) {
+      segment_runs[static_cast<size_t>(k)] = internal::LocalRegressionRuns(
           t, z, starts[k], starts[k + 1], curve.segments_[k], local ? window_values : fit_values,
           local ? window_rates : fit_rates, fit_values, fit_rates, local ? &local_samples[k] : nullptr, profile);
+    });
+    std::vector<LocalRun> regression;
+    for (size_t k = 0; k + 1 < starts.size(); ++k) {
+      std::vector<LocalRun>& runs = segment_runs[k];
       if (local) {
         const Eigen::Index n = starts[k + 1] - starts[k];
         for (const LocalRun& run : runs) {
