@@ -1209,7 +1209,9 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
         const Eigen::Index n = starts[k + 1] - starts[k];
         for (const LocalRun& run : runs) {
           const auto [from, to] = internal::SamplesOf(t, starts[k], n, run);
-          if (to > from) local_samples[k].local.middleRows(from, to - from).setConstant(false);
+          if (to <= from) continue;
+          local_samples[k].local.middleRows(from, to - from).setConstant(false);
+          local_samples[k].modelled.middleRows(from, to - from).setConstant(false);
         }
       }
       std::move(runs.begin(), runs.end(), std::back_inserter(regression));

@@ -839,9 +839,9 @@ bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eige
   const auto count = static_cast<Eigen::Index>(windows.size());
   if (n < 5 || count == 0 || rates.spline_slopes.rows() != n || rates.three_rates.rows() != n) return false;
   // The samples and coordinates open to a new rate: those the local regression left, except local
-  // ones whose stencil the held-out errors' model chose knowing the motion's frequency (their
-  // orders fell: UnderResolvedRates; without noise the spline's bias is what the comparison below
-  // would see) and samples whose 5-point stencil holds a close step (Close: their local rate is
+  // ones whose stencil the held-out errors' model chose knowing the motion's frequency
+  // (LocalSamples::modelled: their orders fell; without noise the spline's bias is what the
+  // comparison below would see) and samples whose 5-point stencil holds a close step (Close: their local rate is
   // another).
   const std::vector<Eigen::Index> owner = SampleWindows(t, first, n, windows);
   const Eigen::VectorXd steps = t.segment(first + 1, n - 1) - t.segment(first, n - 1);
@@ -851,7 +851,7 @@ bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eige
     for (Eigen::Index j = std::max<Eigen::Index>(0, i - 2); j <= std::min(n - 2, i + 1); ++j) close = close || Close(steps, j);
     if (close || !(steps[i - 1] > 0.0) || !(steps[i] > 0.0)) continue;
     for (Eigen::Index c = 0; c < d; ++c) {
-      open(i, c) = !(chosen->local(i, c) && rates.modelled(owner[static_cast<size_t>(i)], c));
+      open(i, c) = !chosen->modelled(i, c);
     }
   }
   for (const LocalRun& run : regression) {

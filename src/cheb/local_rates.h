@@ -70,7 +70,8 @@ LocalRates UnderResolvedRates(const Eigen::VectorXd& t, const Eigen::MatrixXd& z
 /// Per sample of a segment (rows) and coordinate (columns): whether the curve follows the sample
 /// there (`local`), whether its rate is then the 5-point one (`five`) or the spline's slopes
 /// (`spline`) instead of the 3-point one, and whether that stencil was chosen knowing the motion's
-/// frequency (`modelled`: the held-out errors' orders fell, LocalRates::modelled).
+/// frequency (`modelled`: the held-out errors' orders fell, LocalRates::modelled; only where
+/// `local`).
 struct LocalSamples {
   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> local, five, spline, modelled;
 };
