@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "cheval/cheb/chebyshev.h"
@@ -170,7 +171,7 @@ Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloc
     }
     if (offsets == 0) continue;
     for (const int p : kCapDegrees) {
-      if (m >= kLongCap ? 4 * (p + 1) > m : 2 * (p + 1) + 1 > m) break;
+      if (m >= kLongCap ? 4 * (p + 1) > m : p + 3 > m) break;
       candidates.push_back({m, p, offsets, Eigen::MatrixXd::Zero(offsets, d), Eigen::MatrixXd::Zero(offsets, d)});
     }
     block_samples = std::max<Eigen::Index>(block_samples, m);
@@ -226,7 +227,11 @@ Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloc
       for (Eigen::Index o = 0; o < n; ++o) w[o] = CapWeight(o, boundary);
       Choice choice{0.0, m, boundary, std::vector<int>(d, -1)};
       for (Eigen::Index c = 0; c < d; ++c) {
-        double lowest = 0.0;  // keeping the end window's polynomial changes nothing
+        // Keeping the end window's polynomial changes nothing, but only a cap within the end
+        // window's samples can keep it: re-expanded over a longer interval, the polynomial is
+        // extrapolated there (degree 17 over 6 times its span: coefficients 1e13 times its values,
+        // whose cancellation left the rate 3,000 m/s off on a 0.5 m/s sine).
+        double lowest = m <= end_samples ? 0.0 : std::numeric_limits<double>::infinity();
         for (size_t k = i; k < j; ++k) {
           const double gain =
               w.cwiseAbs2().dot(candidates[k].a.col(c).head(n)) + 2.0 * w.dot(candidates[k].b.col(c).head(n));

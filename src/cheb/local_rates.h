@@ -50,6 +50,10 @@ struct LocalRates {
   /// Whether the held-out errors fell with the order (the stencil was chosen knowing the motion's
   /// frequency), per window and coordinate.
   Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> modelled;
+  /// Whether, at a segment's end sample, the quintic's one-sided rate through it and the next five
+  /// errs less than the quadratic's through it and the next two, by the same model of noise and
+  /// motion as the stencil, per window and coordinate.
+  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> one_sided_quintic;
 };
 
 /// The LocalRates of the windows of `segment`. Over the window's core, the held-out errors of the
