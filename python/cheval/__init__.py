@@ -160,7 +160,9 @@ def velocity(source, *, at=None, method="chebyshev", degree="auto", window=None,
     Returns a dict: 'stamps' (n,) int64, 'velocities' (n, 3) m/s, 'positions' (n, 3) fitted
     (chebyshev; else None), 'angular_velocities' (n, 3) rad/s or None, 'orientations' (n, 4) x y z w
     fitted (chebyshev with angular) or None, 'curve' (the fitted Curve, chebyshev) or None,
-    'angular_residual_rms' (rad) or None. No array is copied on the way out.
+    'angular_residual_rms' (rad) or None, 'rounded_stamps' ({'resolution_s', 'rate_hz'} where the
+    stamps were a uniform rate rounded to a coarser resolution and the fit took the uniform instants,
+    docs/velocity.md "Rounded stamps"; else None). No array is copied on the way out.
     quat_order: 'xyzw' or 'wxyz', the order of a mapping's quaternions and of 'orientations' (default:
     the source trajectory's quat_order; 'wxyz' copies 'orientations').
     """

@@ -121,6 +121,21 @@ class VelocityTest(unittest.TestCase):
                                       cheval.fit(self.measured, threads=1).evaluate(self.truth.stamps, order=1)[1])
 
 
+    def test_rounded_stamps_are_said(self):
+        # 240 Hz written in whole milliseconds (steps of 4 and 5 ms), smooth motion.
+        exact = 400_000 + np.round(np.arange(2401) * 1e9 / 240).astype(np.int64)
+        stamps = (exact + 500_000) // 1_000_000 * 1_000_000
+        t = exact * 1e-9
+        positions = np.column_stack([0.2 * np.sin(1.3 * t), 0.1 * np.cos(2.1 * t), 0.05 * np.sin(3.7 * t)])
+        out = cheval.velocity({"stamps": stamps, "positions": positions})
+        self.assertEqual(out["rounded_stamps"]["resolution_s"], 1e-3)
+        self.assertAlmostEqual(out["rounded_stamps"]["rate_hz"], 240.0, places=6)
+        truth = np.column_stack([0.26 * np.cos(1.3 * t), -0.21 * np.sin(2.1 * t), 0.185 * np.cos(3.7 * t)])
+        central = cheval.velocity({"stamps": stamps, "positions": positions}, method="central")
+        self.assertLess(rmse(out["velocities"], truth), 0.1 * rmse(central["velocities"], truth))
+        self.assertIsNone(cheval.velocity(self.measured)["rounded_stamps"])
+
+
 class FitTest(unittest.TestCase):
     def test_a_polynomial_is_fitted_and_differentiated_exactly(self):
         stamps = np.arange(0, 2001, dtype=np.int64) * 1_000_000  # 2 s at 1 kHz

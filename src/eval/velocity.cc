@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Cholesky>
 #include <fmt/format.h>
@@ -171,6 +172,39 @@ int SavitzkyGolaySamples(std::span<const int64_t> stamps_ns, double window_s) {
   return std::max(samples, 5);
 }
 
+std::optional<RoundedStamps> RoundedUniformStamps(std::span<const int64_t> stamps_ns) {
+  const auto n = static_cast<int64_t>(stamps_ns.size());
+  if (n < 8) return std::nullopt;
+  int64_t shortest = std::numeric_limits<int64_t>::max(), longest = std::numeric_limits<int64_t>::min();
+  for (int64_t i = 1; i < n; ++i) {
+    const int64_t step = stamps_ns[i] - stamps_ns[i - 1];
+    shortest = std::min(shortest, step);
+    longest = std::max(longest, step);
+  }
+  // Two step values q apart, the shorter at least 2q (a resolution coarser than the steps is not a
+  // rounding of them), and no third value.
+  const int64_t q = longest - shortest;
+  if (shortest <= 0 || q <= 0 || shortest < 2 * q) return std::nullopt;
+  for (int64_t i = 1; i < n; ++i) {
+    const int64_t step = stamps_ns[i] - stamps_ns[i - 1];
+    if (step != shortest && step != longest) return std::nullopt;
+  }
+  const double period = static_cast<double>(stamps_ns[n - 1] - stamps_ns[0]) / static_cast<double>(n - 1);
+  double low = 0.0, high = 0.0;  // the stamps' offsets from the line through the first and last
+  for (int64_t i = 0; i < n; ++i) {
+    const double offset = static_cast<double>(stamps_ns[i] - stamps_ns[0]) - period * static_cast<double>(i);
+    low = std::min(low, offset), high = std::max(high, offset);
+  }
+  if (high - low > static_cast<double>(q) + 1.0) return std::nullopt;  // 1 ns: the line's own rounding
+  RoundedStamps rounded{q, period, std::vector<int64_t>(static_cast<size_t>(n))};
+  const double centre = 0.5 * (low + high);
+  for (int64_t i = 0; i < n; ++i) {
+    rounded.uniform_ns[static_cast<size_t>(i)] =
+        stamps_ns[0] + std::llround(centre + period * static_cast<double>(i));
+  }
+  return rounded;
+}
+
 VelocityEstimate EstimateVelocity(const traj::TrajectoryView& trajectory, const VelocityOptions& options,
                                   std::optional<std::span<const int64_t>> at_ns) {
   options.Validate();
@@ -193,8 +227,25 @@ VelocityEstimate EstimateVelocity(const traj::TrajectoryView& trajectory, const 
     return estimate;
   }
   const Eigen::MatrixXd positions = trajectory.positions().transpose();
-  cheb::Curve curve = cheb::FitCurve(trajectory.stamps_ns(), positions, options.curve);
-  const std::span<const int64_t> query = at_ns ? *at_ns : trajectory.stamps_ns();
+  // Rounded stamps err by up to half their resolution, the motion times that read as noise and
+  // jumps: the fit takes the uniform instants they were rounded from (docs/velocity.md, "Rounded
+  // stamps").
+  estimate.rounded_stamps = RoundedUniformStamps(trajectory.stamps_ns());
+  const std::span<const int64_t> stamps =
+      estimate.rounded_stamps ? std::span<const int64_t>(estimate.rounded_stamps->uniform_ns) : trajectory.stamps_ns();
+  cheb::Curve curve = cheb::FitCurve(stamps, positions, options.curve);
+  // Query stamps that are the trajectory's own (a reference's paired samples) are its samples'
+  // uniform instants too; others are taken as given.
+  std::vector<int64_t> mapped;
+  if (estimate.rounded_stamps && at_ns) {
+    const std::span<const int64_t> own = trajectory.stamps_ns();
+    mapped.assign(at_ns->begin(), at_ns->end());
+    for (int64_t& stamp : mapped) {
+      const auto it = std::lower_bound(own.begin(), own.end(), stamp);
+      if (it != own.end() && *it == stamp) stamp = estimate.rounded_stamps->uniform_ns[static_cast<size_t>(it - own.begin())];
+    }
+  }
+  const std::span<const int64_t> query = !at_ns ? stamps : mapped.empty() ? *at_ns : std::span<const int64_t>(mapped);
   Eigen::MatrixXd values, derivatives;
   curve.EvaluateMany(query, 1, &values, &derivatives);
   estimate.positions = values.transpose();
@@ -207,7 +258,7 @@ VelocityEstimate EstimateVelocity(const traj::TrajectoryView& trajectory, const 
     rotation_options.curve = options.curve;
     // The charts' noise varies along them: a choice by one σ is not reliable there (docs/velocity.md).
     rotation_options.curve.local_regression = false;
-    RotationCurve rotation = FitRotationCurve(trajectory.stamps_ns(), rotations, rotation_options);
+    RotationCurve rotation = FitRotationCurve(stamps, rotations, rotation_options);
     rotation.EvaluateMany(query, &estimate.orientations, &estimate.angular_velocities);
     estimate.rotation_curve = std::move(rotation);
   }
@@ -310,6 +361,10 @@ std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimat
     j["noise_sigma_m"] = std::vector<double>(curve.noise_sigma().data(), curve.noise_sigma().data() + 3);
     j["noise_sigma_max_m"] = std::vector<double>(curve.noise_sigma_max().data(), curve.noise_sigma_max().data() + 3);
     j["noisier_samples"] = curve.noisier_samples();
+    if (estimate.rounded_stamps) {
+      j["rounded_stamps"] = {{"resolution_s", static_cast<double>(estimate.rounded_stamps->resolution_ns) * 1e-9},
+                             {"rate_hz", 1e9 / estimate.rounded_stamps->period_ns}};
+    }
     j["residual_rmse_m"] = std::vector<double>(curve.residual_rms().data(), curve.residual_rms().data() + 3);
     j["compression_ratio"] = static_cast<double>(3 * run.input_poses) / static_cast<double>(curve.stored_values());
     j["unresolved_windows"] = curve.unresolved_windows();

@@ -75,6 +75,12 @@ void Run(const VelocityFlags& flags) {
     return;
   }
   const cheb::Curve& curve = *estimate.curve;
+  if (estimate.rounded_stamps) {
+    fmt::print(stderr, "cheval: note: {}: the stamps are a uniform {:.6g} Hz rounded to {:g} s; fitted at the uniform "
+               "instants (docs/velocity.md, \"Rounded stamps\")\n",
+               flags.input, 1e9 / estimate.rounded_stamps->period_ns,
+               static_cast<double>(estimate.rounded_stamps->resolution_ns) * 1e-9);
+  }
   if (const std::string warning = eval::UnresolvedWarning(curve); !warning.empty()) {
     fmt::print(stderr, "cheval: warning: {}: {}\n", flags.input, warning);
   }

@@ -64,6 +64,25 @@ std::string DegreeName(const cheb::CurveOptions& options);
 /// ((n - 1) / duration): the nearest odd number, at least 5.
 int SavitzkyGolaySamples(std::span<const int64_t> stamps_ns, double window_s);
 
+/// Stamps rounded to a resolution from a uniform rate (RoundedUniformStamps).
+struct RoundedStamps {
+  /// The rounding's resolution (ns) and the uniform period (ns) the stamps were rounded from.
+  int64_t resolution_ns = 0;
+  double period_ns = 0.0;
+  /// The uniform stamps (ns), one per input stamp: the instants the samples were taken.
+  std::vector<int64_t> uniform_ns;
+};
+
+/// Whether `stamps_ns` are a uniform rate rounded to a coarser resolution q (a recorder writing
+/// 240 Hz in whole milliseconds: steps of 4 and 5 ms), and then the uniform stamps. Exact: every
+/// step is one of two values q apart, both occur, and the stamps stay within q of the straight
+/// line through the first and last (rounding moves each by at most q/2); the uniform stamps are
+/// that line centred on them. Such stamps err by up to q/2, which for motion at v reads as noise of
+/// v·q/sqrt(12) with a pattern that repeats (0.1 mm at 0.3 m/s and 1 ms) and as jumps where the
+/// pattern steps. Nullopt for fewer than 8 stamps, for even or irregular stamps, a dropped sample
+/// or a gap.
+std::optional<RoundedStamps> RoundedUniformStamps(std::span<const int64_t> stamps_ns);
+
 /// Velocities and what the Chebyshev fit chose.
 struct VelocityEstimate {
   /// 3 x n world-frame velocities (m/s) at the query stamps.
@@ -77,10 +96,15 @@ struct VelocityEstimate {
   /// With `angular` and kChebyshev: the fitted orientations at the query stamps and the curve.
   std::vector<Eigen::Quaterniond> orientations;
   std::optional<RotationCurve> rotation_curve;
+  /// kChebyshev: where the stamps were rounded from a uniform rate (RoundedUniformStamps), the
+  /// uniform stamps the curves were fitted and evaluated at (at the trajectory's own stamps).
+  std::optional<RoundedStamps> rounded_stamps;
 };
 
 /// Estimates world-frame velocity at `at_ns` (nullopt: at the trajectory's own stamps) from its
-/// positions. Central differences and Savitzky–Golay work only at the trajectory's own stamps
+/// positions. With kChebyshev, stamps rounded from a uniform rate (RoundedUniformStamps) are
+/// replaced by the uniform ones for the fit and for evaluating at the trajectory's own stamps
+/// (`at_ns` that are among them too: a reference's paired samples). Central differences and Savitzky–Golay work only at the trajectory's own stamps
 /// (OptionError naming VelocityOptions::method otherwise); they need stamps in increasing order
 /// (ComputeError otherwise). Throws OptionError for bad options (options.Validate()) and for
 /// angular on a trajectory without orientation, ComputeError for a trajectory without stamps and
@@ -115,8 +139,10 @@ struct VelocityRun {
 /// The JSON of `cheval velocity --json` (docs/velocity.md): command, input {path, poses}, method,
 /// evaluated_at; with a Chebyshev curve degree_method (DegreeName), segments, windows, degrees (per
 /// window and coordinate), window_list (begin_s, end_s, samples, degrees), noise_sigma_m,
-/// residual_rmse_m, compression_ratio (3 n / stored values); with a rotation curve angular {charts,
-/// residual_rms_rad}; seconds. 2-space indentation and a final newline.
+/// residual_rmse_m, compression_ratio (3 n / stored values), and rounded_stamps {resolution_s,
+/// rate_hz} where the stamps were rounded (RoundedUniformStamps); with a rotation curve angular
+/// {charts, residual_rms_rad}; seconds. 2-space indentation and a final newline. (docs/velocity.md,
+/// "Output, `--json` and messages", lists every field.)
 std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimate);
 
 }  // namespace cheval::eval
