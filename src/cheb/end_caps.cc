@@ -18,8 +18,10 @@ namespace {
 // and the blending boundary z (in samples from the end: the cap alone up to z/2, blended into the
 // end window up to 1.5 z).
 constexpr std::array<int, 11> kCapSamples{8, 11, 16, 23, 32, 45, 64, 91, 128, 181, 256};
-// Caps of fewer samples may spend a coefficient on every 2 samples (m ≥ 2(p + 1) + 1): mid-band
-// motion at 20–50 Hz, whose best Savitzky–Golay window is a cubic over 9 samples. The samples
+// Caps of fewer samples may keep only two samples more than their coefficients (m ≥ p + 3, up to
+// degree 5 over 8 samples): mid-band motion at 20–50 Hz, whose best Savitzky–Golay window is a
+// cubic over 9 samples, and at 20 Hz, 12 samples a period, which only a degree close to the
+// samples follows from one side (the pooled artificial ends judge its noise). The samples
 // next to a real end can be unlike the artificial ends that choose the cap, and a short cap
 // follows them: at a jump they carry its onset, and short caps are not tried there; at a
 // recording's end (a landing) one is taken only when its pooled gain is kShortCapMargin times the
