@@ -1,7 +1,8 @@
 #pragma once
 // Isolated defects of sampled motion that no smooth curve should absorb (FitCurve, robust fits):
-// a sample displaced from its neighbours (a glitch), a jump of the positions that persists (a
-// relocalisation of the ground truth), and a jump of the velocity (an impact). Found on the slopes
+// a sample displaced from its neighbours (a glitch) or a few consecutive ones (an excursion: a
+// marker swap, a lost track), a jump of the positions that persists (a relocalisation of the
+// ground truth), and a jump of the velocity (an impact). Found on the slopes
 // between consecutive samples, d_j = (z_{j+1} − z_j)/(t_{j+1} − t_j), each compared with straight
 // lines fitted to its neighbours on either side; docs/velocity.md, "Jumps and glitches".
 
@@ -13,7 +14,7 @@
 namespace cheval::cheb::internal {
 
 struct Jumps {
-  /// Samples to leave out of the fit (glitches), ascending.
+  /// Samples to leave out of the fit (glitches and excursions), ascending, each once.
   std::vector<Eigen::Index> outliers;
   /// Boundaries b (ascending) where the motion jumps between samples b and b + 1 and its rate does
   /// not go on across (an impact, or a jump too close to another to tell): the fit is split there
