@@ -72,8 +72,8 @@ py::dict Velocity(const py::object& self, const py::object& at, const std::strin
       estimate.rotation_curve ? py::cast(estimate.rotation_curve->residual_rms_rad()) : py::object(py::none());
   if (estimate.rounded_stamps) {
     py::dict rounded;
-    rounded["resolution_s"] = static_cast<double>(estimate.rounded_stamps->resolution_ns) * 1e-9;
-    rounded["rate_hz"] = 1e9 / estimate.rounded_stamps->period_ns;
+    rounded["resolution_s"] = estimate.rounded_stamps->resolution_s();
+    rounded["rate_hz"] = estimate.rounded_stamps->rate_hz();
     out["rounded_stamps"] = rounded;
   } else {
     out["rounded_stamps"] = py::none();

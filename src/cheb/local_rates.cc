@@ -869,7 +869,8 @@ LocalSamples ChooseLocalSamples(const Eigen::VectorXd& t, Eigen::Index first, Ei
                     rates.under_resolved(k, c);
       five(i, c) = rates.stencil(k, c) == 5;
       spline(i, c) = rates.stencil(k, c) == kSpline;
-      // At the segment's ends these say whether the end sample takes the one-sided quintic (BuildLocalRuns).
+      // At the segment's ends these say whether the end sample takes the one-sided quintic
+      // (BuildLocalRuns).
       if ((i == 0 || i == n - 1) && !rates.one_sided_quintic(k, c)) five(i, c) = spline(i, c) = false;
       chosen.modelled(i, c) = local(i, c) && rates.modelled(k, c);
     }
@@ -894,8 +895,8 @@ bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eige
   // The samples and coordinates open to a new rate: those the local regression left, except local
   // ones whose stencil the held-out errors' model chose knowing the motion's frequency
   // (LocalSamples::modelled: their orders fell; without noise the spline's bias is what the
-  // comparison below would see) and samples whose 5-point stencil holds a close step (Close: their local rate is
-  // another).
+  // comparison below would see) and samples whose 5-point stencil holds a close step (Close: their
+  // local rate is another).
   const std::vector<Eigen::Index> owner = SampleWindows(t, first, n, windows);
   const Eigen::VectorXd steps = t.segment(first + 1, n - 1) - t.segment(first, n - 1);
   Flags open = Flags::Constant(n, d, false);

@@ -362,8 +362,8 @@ std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimat
     j["noise_sigma_max_m"] = std::vector<double>(curve.noise_sigma_max().data(), curve.noise_sigma_max().data() + 3);
     j["noisier_samples"] = curve.noisier_samples();
     if (estimate.rounded_stamps) {
-      j["rounded_stamps"] = {{"resolution_s", static_cast<double>(estimate.rounded_stamps->resolution_ns) * 1e-9},
-                             {"rate_hz", 1e9 / estimate.rounded_stamps->period_ns}};
+      j["rounded_stamps"] = {{"resolution_s", estimate.rounded_stamps->resolution_s()},
+                             {"rate_hz", estimate.rounded_stamps->rate_hz()}};
     }
     j["residual_rmse_m"] = std::vector<double>(curve.residual_rms().data(), curve.residual_rms().data() + 3);
     j["compression_ratio"] = static_cast<double>(3 * run.input_poses) / static_cast<double>(curve.stored_values());

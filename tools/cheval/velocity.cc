@@ -78,8 +78,7 @@ void Run(const VelocityFlags& flags) {
   if (estimate.rounded_stamps) {
     fmt::print(stderr, "cheval: note: {}: the stamps are a uniform {:.6g} Hz rounded to {:g} s; fitted at the uniform "
                "instants (docs/velocity.md, \"Rounded stamps\")\n",
-               flags.input, 1e9 / estimate.rounded_stamps->period_ns,
-               static_cast<double>(estimate.rounded_stamps->resolution_ns) * 1e-9);
+               flags.input, estimate.rounded_stamps->rate_hz(), estimate.rounded_stamps->resolution_s());
   }
   if (const std::string warning = eval::UnresolvedWarning(curve); !warning.empty()) {
     fmt::print(stderr, "cheval: warning: {}: {}\n", flags.input, warning);

@@ -71,6 +71,9 @@ struct RoundedStamps {
   double period_ns = 0.0;
   /// The uniform stamps (ns), one per input stamp: the instants the samples were taken.
   std::vector<int64_t> uniform_ns;
+
+  double resolution_s() const { return static_cast<double>(resolution_ns) * 1e-9; }
+  double rate_hz() const { return 1e9 / period_ns; }
 };
 
 /// Whether `stamps_ns` are a uniform rate rounded to a coarser resolution q (a recorder writing
@@ -104,8 +107,9 @@ struct VelocityEstimate {
 /// Estimates world-frame velocity at `at_ns` (nullopt: at the trajectory's own stamps) from its
 /// positions. With kChebyshev, stamps rounded from a uniform rate (RoundedUniformStamps) are
 /// replaced by the uniform ones for the fit and for evaluating at the trajectory's own stamps
-/// (`at_ns` that are among them too: a reference's paired samples). Central differences and Savitzky–Golay work only at the trajectory's own stamps
-/// (OptionError naming VelocityOptions::method otherwise); they need stamps in increasing order
+/// (`at_ns` that are among them too: a reference's paired samples). Central differences and
+/// Savitzky–Golay work only at the trajectory's own stamps (OptionError naming
+/// VelocityOptions::method otherwise); they need stamps in increasing order
 /// (ComputeError otherwise). Throws OptionError for bad options (options.Validate()) and for
 /// angular on a trajectory without orientation, ComputeError for a trajectory without stamps and
 /// when the data cannot support the method (too few samples, equal stamps...).
