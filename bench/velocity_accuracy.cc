@@ -7,7 +7,7 @@
 // central differences, a cubic smoothing spline with GCV (smoothing_spline.h), and one global
 // Chebyshev fit of fixed degree 400 (the C-ASE paper's choice for CARLA). Besides the simulator's
 // kinds: hand tremor on a handheld motion, velocity steps (impacts) on a noise-free legged one, a
-// vibration near a quarter of the rate and bursts of noise.
+// vibration near a quarter of the rate, bursts of noise and stamps off by white errors.
 // Ratios are against the baselines measured in the same run. A second table: body angular velocity
 // from noisy orientations.
 //   build/bench/velocity_accuracy [DATA_DIR [SEEDS [FIRST_SEED [ROWS]]]]
@@ -204,6 +204,29 @@ Case Bursts() {
                    });
 }
 
+// Stamps off by white errors of 0.3 ms RMS (a recorder that stamps samples on arrival) on a
+// noise-free handheld motion at 200 Hz: each sample lies v·δ from the motion at its stamp
+// (docs/velocity.md, "Stamp noise"). Scored at the stamps against the velocity at the instants the
+// samples were taken.
+Case StampErrors() {
+  sim::MotionOptions options;
+  options.kind = sim::MotionKind::kHandheld;
+  options.rate_hz = 200;
+  const sim::MotionModel model(options);
+  const traj::Trajectory taken = sim::Measure(model, sim::MeasurementOptions{});
+  std::mt19937_64 rng(12);
+  std::normal_distribution<double> error(0.0, 3e-4);
+  Case c;
+  c.name = "stamp errors, 0.0 mm";
+  c.truth = sim::SampleMotion(model, taken.stamps_ns()).View().velocities();
+  c.measured.Reserve(taken.size());
+  for (Eigen::Index i = 0; i < taken.size(); ++i) {
+    const Eigen::Vector3d p = taken.positions().col(i);
+    c.measured.Append(taken.stamps_ns()[i] + std::llround(1e9 * error(rng)), p.data());
+  }
+  return c;
+}
+
 // Body angular velocity from noisy orientations: the RotationCurve against central differences on
 // the group, full range, on the simulator's exact body rates.
 void AngularTable() {
@@ -277,7 +300,7 @@ int main(int argc, char** argv) {
       }
     }
   }
-  for (const Case& c : {Tremor(0.0005), Tremor(0.0), Impacts(), Vibration(), Bursts()}) {
+  for (const Case& c : {Tremor(0.0005), Tremor(0.0), Impacts(), Vibration(), Bursts(), StampErrors()}) {
     if (wanted(c.name)) Print(Evaluate(c.name, c.measured.View(), c.truth));
   }
   for (const char* file : {"MH_05_difficult.csv", "V1_01_easy.csv", "V1_02_medium.csv", "V2_02_medium.csv"}) {

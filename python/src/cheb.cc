@@ -105,6 +105,10 @@ Raises ComputeError for a stamp outside the data by more than `tolerance` second
                              "stretch is clearly noisier; docs/velocity.md, \"Noise profile\").")
       .def_property_readonly("noisier_samples", &cheb::Curve::noisier_samples,
                              "Samples tested against a noise sigma above the recording's (the noise profile).")
+      .def_property_readonly("stamp_noise_s", &cheb::Curve::stamp_noise_s,
+                             "RMS error (s) of the stamps where the samples scatter in proportion to their rate, "
+                             "as stamps off by white errors make them; 0 where they do not (docs/velocity.md, "
+                             "\"Stamp noise\").")
       .def_property_readonly("residual_rms", &cheb::Curve::residual_rms, "RMS of the fit residuals per coordinate.")
       .def_property_readonly("stored_values", &cheb::Curve::stored_values,
                              "Sum over windows of (degree + 1) per coordinate.")

@@ -135,6 +135,16 @@ class VelocityTest(unittest.TestCase):
         self.assertLess(rmse(out["velocities"], truth), 0.1 * rmse(central["velocities"], truth))
         self.assertIsNone(cheval.velocity(self.measured)["rounded_stamps"])
 
+    def test_stamp_noise_is_said(self):
+        # Noise-free samples taken at 200 Hz, stamped 0.3 ms (RMS) off the instants they were taken at.
+        taken = np.arange(4000) / 200.0
+        stamps = np.round((taken + np.random.default_rng(3).normal(0, 3e-4, taken.size)) * 1e9).astype(np.int64)
+        w = 2 * np.pi * np.array([[0.7], [2.3], [6.1]])
+        positions = (0.3 / w * np.sin(w * taken + [[0.0], [1.0], [2.0]])).T
+        out = cheval.velocity({"stamps": stamps, "positions": positions})
+        self.assertAlmostEqual(out["curve"].stamp_noise_s, 3e-4, delta=0.6e-4)
+        self.assertEqual(cheval.velocity(self.measured)["curve"].stamp_noise_s, 0.0)
+
 
 class FitTest(unittest.TestCase):
     def test_a_polynomial_is_fitted_and_differentiated_exactly(self):

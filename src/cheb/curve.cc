@@ -1054,7 +1054,8 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   before.reset();
   magnitudes.reset();
   curve.noisier_samples_ = profile.raised_samples();
-  if (curve.noisier_samples_ > 0) curve.noise_sigma_max_ = profile.maximum();
+  if (profile.varies()) curve.noise_sigma_max_ = profile.maximum();
+  if (profile.stamp_noise()) curve.stamp_noise_s_ = std::sqrt(profile.stamp_noise()->variance);
   const WindowFitter fitter(t, z, profile, options);
 
   // Segment boundaries [starts[k], starts[k+1]), with whether each segment ends at a jump; a

@@ -141,8 +141,7 @@ Eigen::MatrixXd DividedDifferenceMagnitudes(const Eigen::Ref<const Eigen::Vector
   return magnitudes;
 }
 
-// The factor from a median absolute value to a normal distribution's σ.
-constexpr double kMadScale = 1.4826;
+using internal::kMadScale;
 
 // kMadScale · the median of the magnitudes of rows [begin, end) of column c that are not NaN (zero
 // where there is none); `scratch` is reused.
@@ -203,6 +202,13 @@ DifferenceMagnitudes::DifferenceMagnitudes(const Eigen::Ref<const Eigen::VectorX
     if (order == 1) sixth_ = DividedDifferenceMagnitudes<7>(t, z, cut);
     if (order == 2) fourth_ = DividedDifferenceMagnitudes<5>(t, z, cut);
   });
+  rates_ = Eigen::MatrixXd::Zero(m, z.cols());
+  for (Eigen::Index i = 0; i < m; ++i) {
+    Eigen::Index a = i, b = i;
+    while (a > std::max<Eigen::Index>(0, i - 2) && !cut[static_cast<size_t>(a - 1)]) --a;
+    while (b < std::min(m - 1, i + 2) && !cut[static_cast<size_t>(b)]) ++b;
+    if (t[b] > t[a]) rates_.row(i) = (z.row(b) - z.row(a)) / (t[b] - t[a]);
+  }
 }
 
 Eigen::VectorXd DifferenceMagnitudes::Sigma(Eigen::Index begin, Eigen::Index end) const {

@@ -68,9 +68,9 @@ class SlopeScan {
       const double magnitude = n_ >= 0 ? z.col(c).cwiseAbs().maxCoeff() : 0.0;
       noise_floor_[c] = std::max(std::sqrt(2.0) * noise[c], 1e-9 * (1.0 + magnitude));
     }
-    // Where the noise profile is raised (over a burst, the blocks beside it too), its slope noise
-    // floors the scale instead.
-    if (profile != nullptr && profile->raised_samples() > 0) {
+    // Where the noise profile is raised (over a burst, the blocks beside it too) or follows stamp
+    // noise, its slope noise floors the scale instead.
+    if (profile != nullptr && profile->varies()) {
       const Eigen::Index m = t.size(), block = NoiseProfile::kBlock, blocks = (m + block - 1) / block;
       block_floor_.resize(blocks, d_);
       for (Eigen::Index b = 0; b < blocks; ++b) {

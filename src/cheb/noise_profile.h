@@ -3,11 +3,15 @@
 // noisier over some stretches than others: the data's level, a median over all the samples, is
 // the quiet stretches' (docs/velocity.md, "Noise profile").
 
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
 
 namespace cheval::cheb::internal {
+
+/// The factor from a median absolute value to a normal distribution's σ.
+inline constexpr double kMadScale = 1.4826;
 
 /// The k-th smallest (from 0, k < size) of `values`, which are non-negative (not −0) and not NaN,
 /// as std::nth_element finds it; `values` may be reordered and shrunk.
@@ -35,9 +39,32 @@ class DifferenceMagnitudes {
   /// n − ⌊n/2⌋ of them do.
   Eigen::MatrixXi CountsAbove(const Eigen::VectorXd& threshold) const;
 
+  /// The magnitudes of the 4th and 8th divided differences by run start (m x d, NaN where no usable
+  /// run starts; kMadScale times their median is σ).
+  const Eigen::MatrixXd& fourth() const { return fourth_; }
+  const Eigen::MatrixXd& eighth() const { return eighth_; }
+  /// A rate per sample and coordinate (m x d): the secant over the samples up to two on either side
+  /// that no boundary separates from it; 0 where it has no neighbour at another stamp.
+  const Eigen::MatrixXd& rates() const { return rates_; }
+
  private:
   Eigen::MatrixXd fourth_, sixth_, eighth_;  // m x d, NaN where no usable run starts
+  Eigen::MatrixXd rates_;
 };
+
+/// Noise from the stamps (docs/velocity.md, "Stamp noise"): samples taken at t_i + δ_i but stamped
+/// t_i, with white δ of RMS τ, are off by v(t_i)·δ_i: white noise whose variance grows with the
+/// speed, σ_c²(i) = s_c² + τ²·v_c(t_i)², s_c the positions' own noise.
+struct StampNoise {
+  double variance = 0.0;      // τ² in s²
+  Eigen::VectorXd intercept;  // s_c² per coordinate (never negative)
+};
+
+/// Stamp noise, where the differences' magnitudes show it: their variance in bins of speed lies on
+/// a line in the squared rate, steeply enough to be told from the bins' scatter, in the 4th and the
+/// 8th differences alike (motion's leak into them grows with the speed too, but falls with the
+/// order, while white noise's does not). nullopt where they do not, and below a few hundred samples.
+std::optional<StampNoise> FindStampNoise(const DifferenceMagnitudes& magnitudes);
 
 /// The noise σ per coordinate along the samples: the data's level, raised over blocks of
 /// kBlock samples whose own estimate, pooled over kPooledBlocks blocks on either side, exceeds it
@@ -55,7 +82,9 @@ class NoiseProfile {
 
   /// The level everywhere.
   explicit NoiseProfile(const Eigen::VectorXd& level);
-  /// The level, raised where the samples' `magnitudes` say they are noisier.
+  /// The level, raised where the samples' `magnitudes` say they are noisier. Where they show stamp
+  /// noise (FindStampNoise), its σ_c(i) takes the level's place, and is raised by the same rules
+  /// against its own RMS.
   NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitudes& magnitudes, Eigen::Index m);
 
   /// The root mean square of σ over samples [first, first + count), per coordinate.
@@ -66,9 +95,14 @@ class NoiseProfile {
   Eigen::Index raised_samples() const { return raised_samples_; }
   /// The largest σ per coordinate (the level where nothing is raised).
   const Eigen::VectorXd& maximum() const { return maximum_; }
+  /// The stamp noise found, if any.
+  const std::optional<StampNoise>& stamp_noise() const { return stamp_noise_; }
+  /// Whether σ differs from the level anywhere (raised, or stamp noise).
+  bool varies() const { return cumulative_.size() > 0; }
 
  private:
   Eigen::VectorXd level_, maximum_;
+  std::optional<StampNoise> stamp_noise_;
   Eigen::MatrixXd cumulative_;  // (m + 1) x d: Σ σ² over the samples before each row; empty: the level
   Eigen::Index raised_samples_ = 0;
 };

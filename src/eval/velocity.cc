@@ -361,6 +361,7 @@ std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimat
     j["noise_sigma_m"] = std::vector<double>(curve.noise_sigma().data(), curve.noise_sigma().data() + 3);
     j["noise_sigma_max_m"] = std::vector<double>(curve.noise_sigma_max().data(), curve.noise_sigma_max().data() + 3);
     j["noisier_samples"] = curve.noisier_samples();
+    j["stamp_noise_s"] = curve.stamp_noise_s();
     if (estimate.rounded_stamps) {
       j["rounded_stamps"] = {{"resolution_s", estimate.rounded_stamps->resolution_s()},
                              {"rate_hz", estimate.rounded_stamps->rate_hz()}};

@@ -176,10 +176,11 @@ TEST_F(CliTest, VelocityFromNoisyPositions) {
   EXPECT_LT(cheb, 0.01 * diff) << cheb << " vs central " << diff;
   const nlohmann::json j = nlohmann::json::parse(Slurp(Path("v.json")));
   for (const char* key : {"method", "windows", "degrees", "noise_sigma_m", "noise_sigma_max_m", "noisier_samples",
-                          "residual_rmse_m", "compression_ratio", "seconds"}) {
+                          "stamp_noise_s", "residual_rmse_m", "compression_ratio", "seconds"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_NEAR(j["noise_sigma_m"][0].get<double>(), 0.0005, 0.0001);
+  EXPECT_EQ(j["stamp_noise_s"].get<double>(), 0.0);  // the simulator's stamps are the instants sampled
   for (int c = 0; c < 3; ++c) EXPECT_GE(j["noise_sigma_max_m"][c].get<double>(), j["noise_sigma_m"][c].get<double>());
   EXPECT_GT(j["compression_ratio"].get<double>(), 10.0);
   // --at: evaluate at other stamps (here every 10th measured stamp, from a stamps file).

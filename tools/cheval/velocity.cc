@@ -88,6 +88,11 @@ void Run(const VelocityFlags& flags) {
                "split at {} jump(s) (--json lists the windows; docs/velocity.md, \"Jumps and glitches\")\n",
                flags.input, curve.outlier_times().size(), curve.step_times().size(), curve.jump_times().size());
   }
+  if (curve.stamp_noise_s() > 0.0) {
+    fmt::print(stderr, "cheval: note: {}: the positions scatter in proportion to their rate, as stamps off by {:.3g} ms "
+               "(RMS) make them; the fit takes that noise into account (docs/velocity.md, \"Stamp noise\")\n",
+               flags.input, 1e3 * curve.stamp_noise_s());
+  }
   size_t windows = 0;
   int min_degree = curve.segments().front().windows.front().degrees.front(), max_degree = min_degree;
   for (const cheb::CurveSegment& segment : curve.segments()) {

@@ -214,6 +214,10 @@ class Curve {
   /// largest σ per coordinate (noise_sigma where none is).
   Eigen::Index noisier_samples() const { return noisier_samples_; }
   const Eigen::VectorXd& noise_sigma_max() const { return noise_sigma_max_.size() > 0 ? noise_sigma_max_ : noise_sigma_; }
+  /// Where the samples scatter in proportion to their rate, as stamps off by white errors make them
+  /// (docs/velocity.md, "Stamp noise"): the RMS of those errors in seconds, and the windows were
+  /// tested against that noise; 0 where no such scatter was found (or noise_sigma was given).
+  double stamp_noise_s() const { return stamp_noise_s_; }
   /// Root mean square of the fit residuals over the samples fitted (outliers left out), per coordinate.
   const Eigen::VectorXd& residual_rms() const { return residual_rms_; }
   /// Total number of stored values (Σ over windows of (degree + 1) per coordinate).
@@ -256,6 +260,7 @@ class Curve {
   Eigen::VectorXd noise_sigma_;
   Eigen::Index noisier_samples_ = 0;
   Eigen::VectorXd noise_sigma_max_;  // empty: noise_sigma_
+  double stamp_noise_s_ = 0.0;
   Eigen::VectorXd residual_rms_;
   std::vector<double> outlier_times_, jump_times_, step_times_;
   // Row k: the sum of the first k + 1 steps, added to values after step_times_[k].
