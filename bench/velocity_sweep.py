@@ -6,7 +6,7 @@ usage: /usr/bin/python3 bench/velocity_sweep.py [--cheval build/cheval] [--data 
 
 Cases: smooth random motion (a few random tones, or a broad random spectrum) whose bandwidth runs from
 well resolved to a quarter of the sample rate, at 20/50/100/200 Hz, noise 0, 1 um, 50 um, 0.5 mm and
-2 mm; uneven stamps (jitter), gaps, velocity steps (impacts); EuRoC ground truth at its own rate and
+2 mm; uneven stamps (jitter), stamps off by white errors, gaps, velocity steps (impacts); EuRoC ground truth at its own rate and
 subsampled (every 2nd/5th/10th row), against its own velocity column. Baselines, computed here:
 central differences, the running median of five central differences, and Savitzky-Golay (local cubic
 on the stamps) with the best odd window 5..201 chosen with the truth (an oracle). Flags, per issue 14:
@@ -161,6 +161,12 @@ def special_cases():
         t = np.arange(n) / rate + np.random.default_rng(9).uniform(-0.1, 0.1, n) / rate
         p, v = evaluate(axes, t)
         yield (f"jitter 10% 100Hz {sigma * 1e3:g}mm", t, p + sigma * noise, v, p)
+        # Stamps off by white errors of 0.3 ms RMS (a recorder that stamps on arrival): the samples
+        # are taken at the period, their stamps are not ("Stamp noise").
+        t = np.arange(n) / rate
+        p, v = evaluate(axes, t)
+        stamps = t + 3e-4 * np.random.default_rng(11).normal(0, 1, n)
+        yield (f"stamp errors 0.3ms 100Hz {sigma * 1e3:g}mm", stamps, p + sigma * noise, v, p)
         # Two gaps, 0.5 s and 2 s.
         t = np.arange(n) / rate
         keep = ~(((t > 5.0) & (t < 5.5)) | ((t > 12.0) & (t < 14.0)))
