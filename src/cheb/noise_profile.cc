@@ -21,9 +21,9 @@ constexpr Eigen::Index kMaxBinRuns = 2000;
 constexpr double kBinScatter4 = 10.8;
 constexpr double kBinScatter8 = 14.5;
 // The slope τ² must stand this many standard errors above zero in the 4th differences, and this
-// many in the 8th: on the sweep's 140 cases without stamp noise the 4th reached 4.3 (a noise-free
-// 200 Hz recording, its 8th at −0.9) and EuRoC's ground truth 11 (its bins off the line, below);
-// stamps jittered by 0.1 ms on noise-free positions score 9–22 and 15–22.
+// many in the 8th: on the sweep's 126 synthetic cases (no stamp noise) the 4th reached 4.3 (a
+// noise-free 200 Hz recording, its 8th at −0.9), and EuRoC's ground truth 11 (its bins off the
+// line, below); stamps jittered by 0.1 ms on noise-free positions score 9–22 and 15–22.
 constexpr double kSlopeScore4 = 6.0;
 constexpr double kSlopeScore8 = 4.0;
 // The bins' variances must lie on the line: a misfit (χ² per degree of freedom, from the bins'
