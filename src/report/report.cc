@@ -139,6 +139,7 @@ Json FitDiagnostics(const cheb::Curve& curve, const Clock& clock, std::size_t ma
               {"noise_sigma_max", std::vector<double>(curve.noise_sigma_max().data(),
                                                       curve.noise_sigma_max().data() + curve.noise_sigma_max().size())},
               {"noisier_samples", curve.noisier_samples()},
+              {"stamp_noise_s", curve.stamp_noise_s()},
               {"residual_rms", std::vector<double>(residual.data(), residual.data() + residual.size())},
               {"unresolved_windows", curve.unresolved_windows()},
               {"local_samples", curve.local_samples()}};

@@ -150,6 +150,7 @@ TEST_F(ReportCliTest, FitDiagnosticsOfTheReference) {
   // recording's; the profile's largest is reported beside it.
   ASSERT_EQ(fit["noise_sigma_max"].size(), 3u);
   EXPECT_TRUE(fit.contains("noisier_samples"));
+  EXPECT_TRUE(fit.contains("stamp_noise_s"));
   for (const Json& w : fit["windows"]) {
     if (!w.contains("residual_rms")) continue;
     ASSERT_EQ(w["noise_sigma"].size(), 3u);
