@@ -208,6 +208,7 @@ DifferenceMagnitudes::DifferenceMagnitudes(const Eigen::Ref<const Eigen::VectorX
     while (a > std::max<Eigen::Index>(0, i - 2) && !cut[static_cast<size_t>(a - 1)]) --a;
     while (b < std::min(m - 1, i + 2) && !cut[static_cast<size_t>(b)]) ++b;
     if (t[b] > t[a]) rates_.row(i) = (z.row(b) - z.row(a)) / (t[b] - t[a]);
+    if (!rates_.row(i).allFinite()) rates_.row(i).setZero();  // non-finite values tell no rate
   }
 }
 

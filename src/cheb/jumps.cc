@@ -47,7 +47,7 @@ class SlopeScan {
             const Eigen::VectorXd& noise, const NoiseProfile* profile)
       : n_(t.size() - 1), d_(z.cols()), slopes_(std::max<Eigen::Index>(n_, 0), z.cols()), mid_(std::max<Eigen::Index>(n_, 0)),
         dt_(std::max<Eigen::Index>(n_, 0)), cut_(static_cast<size_t>(std::max<Eigen::Index>(n_, 0)), 0),
-        masked_(static_cast<size_t>(std::max<Eigen::Index>(n_, 0)), 0) {
+        masked_(static_cast<size_t>(std::max<Eigen::Index>(n_, 0)), 0), profile_(profile) {
     for (Eigen::Index j = 0; j < n_; ++j) {
       dt_[j] = t[j + 1] - t[j];
       mid_[j] = 0.5 * (t[j] + t[j + 1]);
@@ -92,10 +92,10 @@ class SlopeScan {
     const double floor = block_floor_.size() > 0 ? block_floor_(j / NoiseProfile::kBlock, c) : noise_floor_[c];
     return floor / dt_[j];
   }
-  // Whether the noise profile raises the floor of slope j's scale above the recording's (a burst of
-  // noise).
+  // Whether the noise profile raises the floor of slope j's scale above the recording's by a raised
+  // block (a burst of noise), not by stamp noise alone.
   bool Raised(Eigen::Index j) const {
-    if (block_floor_.size() == 0) return false;
+    if (block_floor_.size() == 0 || !profile_->BlockRaised(j / NoiseProfile::kBlock)) return false;
     return (block_floor_.row(j / NoiseProfile::kBlock).transpose().array() > noise_floor_.array()).any();
   }
   bool Usable(Eigen::Index j) const { return !cut_[static_cast<size_t>(j)] && !masked_[static_cast<size_t>(j)]; }
@@ -303,6 +303,7 @@ class SlopeScan {
   std::vector<char> cut_, masked_;
   Eigen::VectorXd noise_floor_;
   Eigen::MatrixXd block_floor_;  // per block of the noise profile; empty: noise_floor_ everywhere
+  const NoiseProfile* profile_ = nullptr;  // the profile block_floor_ comes from
 };
 
 // Each step again, from the samples themselves: a cubic through kStepSamples samples on either

@@ -15,9 +15,9 @@ namespace {
 constexpr Eigen::Index kMinBinRuns = 50;
 constexpr Eigen::Index kMinBins = 4;
 constexpr Eigen::Index kMaxBins = 20;
-constexpr Eigen::Index kMaxBinRuns = 2000;
-// n times the variance of σ̂²/σ² for σ̂ from the median of n runs' magnitudes of white noise
-// (simulated, 6,000 draws of n = 50 and 200: 4th differences 11.5 and 10.8, 8th 16.9 and 14.5).
+// n times the variance of σ̂²/σ² for σ̂ from the median of n consecutive runs' magnitudes of white
+// noise (simulated, 6,000 draws of n = 50 and 200: 4th differences 11.5 and 10.8, 8th 16.9 and
+// 14.5). Every run is taken: the runs overlap, and every other run alone scatters less (6.4, 8.0).
 constexpr double kBinScatter4 = 10.8;
 constexpr double kBinScatter8 = 14.5;
 // The slope τ² must stand this many standard errors above zero in the 4th differences, and this
@@ -26,8 +26,8 @@ constexpr double kBinScatter8 = 14.5;
 // line, below); stamps jittered by 0.1 ms on noise-free positions score 9–22 and 15–22.
 constexpr double kSlopeScore4 = 6.0;
 constexpr double kSlopeScore8 = 4.0;
-// The bins' variances must lie on the line: a misfit (χ² per degree of freedom, from the bins'
-// scatter above) of at most this. Stamp noise gives 0.4–0.8; the speed-dependent noise of real
+// The 4th differences' bins must lie on the line: a misfit (χ² per degree of freedom, from the
+// bins' scatter above) of at most this (the 8th's scatter more, and need only agree in slope). Stamp noise gives 0.4–0.8; the speed-dependent noise of real
 // ground truth (EuRoC 9–25, TUM-VI 8, DIDO 150–210) is something else, and a line would misplace it.
 constexpr double kMaxMisfit = 3.0;
 // The 8th differences' slope must agree with the 4th's to this factor either way: motion leaks
@@ -60,12 +60,9 @@ std::optional<SpeedLine> FitSpeedLine(const Eigen::MatrixXd& magnitudes, const E
   std::vector<Bin> bins;
   std::vector<std::pair<double, double>> runs;  // (squared rate, magnitude)
   std::vector<double> scratch;
-  // A long recording contributes every stride-th run: bins of up to kMaxBinRuns runs already know
-  // their σ² to a few per cent, and sorting every run would cost more than the rest of the profile.
-  const Eigen::Index stride = std::max<Eigen::Index>(1, m / (kMaxBins * kMaxBinRuns));
   for (Eigen::Index c = 0; c < d; ++c) {
     runs.clear();
-    for (Eigen::Index i = 0; i + middle < m; i += stride) {
+    for (Eigen::Index i = 0; i + middle < m; ++i) {
       const double rate = rates(i + middle, c);
       if (!std::isnan(magnitudes(i, c))) runs.emplace_back(rate * rate, magnitudes(i, c));
     }
@@ -77,11 +74,11 @@ std::optional<SpeedLine> FitSpeedLine(const Eigen::MatrixXd& magnitudes, const E
     const auto by_rate = [](const auto& a, const auto& b) { return a.first < b.first; };
     const auto cut = [&](const auto& self, Eigen::Index first, Eigen::Index last) -> void {
       if (last - first < 2) return;
-      const Eigen::Index middle = (first + last) / 2;
+      const Eigen::Index half = (first + last) / 2;
       const auto at = [&](Eigen::Index b) { return runs.begin() + static_cast<std::ptrdiff_t>(n * b / count); };
-      std::nth_element(at(first), at(middle), at(last), by_rate);
-      self(self, first, middle);
-      self(self, middle, last);
+      std::nth_element(at(first), at(half), at(last), by_rate);
+      self(self, first, half);
+      self(self, half, last);
     };
     cut(cut, 0, count);
     for (Eigen::Index b = 0; b < count; ++b) {
@@ -126,8 +123,10 @@ std::optional<SpeedLine> FitSpeedLine(const Eigen::MatrixXd& magnitudes, const E
   }
   fitted = y;
   const Eigen::Index k = columns;  // τ²'s column
+  if (count - k - 1 < 2) return std::nullopt;  // too few bins to tell a line from its scatter
   Eigen::MatrixXd normal(k + 1, k + 1);
-  Eigen::VectorXd rhs(k + 1), theta(k + 1);
+  Eigen::VectorXd rhs(k + 1), theta(k + 1), scale(k + 1);
+  double inverse_kk = 0.0;  // (normal⁻¹)_kk: τ²'s variance in the units below
   for (int iteration = 0; iteration < 3; ++iteration) {
     normal.setZero();
     rhs.setZero();
@@ -143,9 +142,13 @@ std::optional<SpeedLine> FitSpeedLine(const Eigen::MatrixXd& magnitudes, const E
       rhs[k] += weight[j] * y[j] * u[j];
     }
     for (Eigen::Index a = 0; a < k; ++a) normal(k, a) = normal(a, k);
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(normal);
-    if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-12)) return std::nullopt;
-    theta = ldlt.solve(rhs);
+    // Solved scaled to a unit diagonal: weights go as 1/σ⁴, and a coordinate far quieter than the
+    // others would make the raw matrix look singular while the line is well determined.
+    scale = normal.diagonal().cwiseSqrt().cwiseInverse();
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(scale.asDiagonal() * normal * scale.asDiagonal());
+    if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-12) || !scale.allFinite()) return std::nullopt;
+    theta = scale.asDiagonal() * ldlt.solve(scale.asDiagonal() * rhs);
+    inverse_kk = scale[k] * scale[k] * ldlt.solve(Eigen::VectorXd::Unit(k + 1, k))[k];
     for (Eigen::Index j = 0; j < count; ++j) {
       fitted[j] = theta[column[static_cast<size_t>(bins[static_cast<size_t>(j)].c)]] + theta[k] * u[j];
     }
@@ -153,10 +156,9 @@ std::optional<SpeedLine> FitSpeedLine(const Eigen::MatrixXd& magnitudes, const E
   SpeedLine line;
   double chi2 = 0.0;
   for (Eigen::Index j = 0; j < count; ++j) chi2 += weight[j] * (y[j] - fitted[j]) * (y[j] - fitted[j]);
-  line.misfit = chi2 / static_cast<double>(std::max<Eigen::Index>(count - k - 1, 1));
-  const double slope_variance = Eigen::LDLT<Eigen::MatrixXd>(normal).solve(Eigen::VectorXd::Unit(k + 1, k))[k];
+  line.misfit = chi2 / static_cast<double>(count - k - 1);
   line.slope = theta[k] * variance_unit / speed_unit;
-  line.slope_error = std::sqrt(std::max(slope_variance, 0.0) * std::max(line.misfit, 1.0)) * variance_unit / speed_unit;
+  line.slope_error = std::sqrt(std::max(inverse_kk, 0.0) * std::max(line.misfit, 1.0)) * variance_unit / speed_unit;
   line.intercept = Eigen::VectorXd::Zero(d);
   for (Eigen::Index c = 0; c < d; ++c) {
     if (column[static_cast<size_t>(c)] >= 0) line.intercept[c] = theta[column[static_cast<size_t>(c)]] * variance_unit;
@@ -243,15 +245,22 @@ NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitu
     }
     // Raised, a block takes the local σ: the level's as it is, the stamp noise's as the factor it
     // stands above the pool's RMS, which keeps its course with the speed.
-    Eigen::RowVectorXd factor = Eigen::RowVectorXd::Ones(d);
+    // Where the base is 0 over the pool (no noise of its own, no motion), the local σ is taken as
+    // it is.
+    Eigen::RowVectorXd factor = Eigen::RowVectorXd::Ones(d), own = Eigen::RowVectorXd::Zero(d);
     bool raised = false;
     for (Eigen::Index c = 0; c < d; ++c) {
       if (local[c] > threshold[c]) {
-        factor[c] = local[c] / pooled[c];
+        if (pooled[c] > 0.0) {
+          factor[c] = local[c] / pooled[c];
+        } else {
+          own[c] = local[c] * local[c];
+        }
         raised = true;
       }
     }
     if (raised) raised_samples_ += end - begin;
+    raised_blocks_.push_back(raised ? 1 : 0);
     if (base.size() == 0) {
       Eigen::RowVectorXd variance = level.cwiseAbs2().transpose();
       for (Eigen::Index c = 0; c < d; ++c) {
@@ -264,7 +273,7 @@ NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitu
       continue;
     }
     for (Eigen::Index i = begin; i < end; ++i) {
-      const Eigen::RowVectorXd variance = base_at(i).cwiseProduct(factor.cwiseAbs2());
+      const Eigen::RowVectorXd variance = base_at(i).cwiseProduct(factor.cwiseAbs2()) + own;
       maximum_ = maximum_.cwiseMax(variance.transpose().cwiseSqrt());
       cumulative_.row(i + 1) = cumulative_.row(i) + variance;
     }

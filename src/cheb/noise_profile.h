@@ -44,7 +44,8 @@ class DifferenceMagnitudes {
   const Eigen::MatrixXd& fourth() const { return fourth_; }
   const Eigen::MatrixXd& eighth() const { return eighth_; }
   /// A rate per sample and coordinate (m x d): the secant over the samples up to two on either side
-  /// that no boundary separates from it; 0 where it has no neighbour at another stamp.
+  /// that no boundary separates from it; 0 where it has no neighbour at another stamp, or where a
+  /// value is not finite.
   const Eigen::MatrixXd& rates() const { return rates_; }
 
  private:
@@ -60,10 +61,11 @@ struct StampNoise {
   Eigen::VectorXd intercept;  // s_c² per coordinate (never negative)
 };
 
-/// Stamp noise, where the differences' magnitudes show it: their variance in bins of speed lies on
-/// a line in the squared rate, steeply enough to be told from the bins' scatter, in the 4th and the
-/// 8th differences alike (motion's leak into them grows with the speed too, but falls with the
-/// order, while white noise's does not). nullopt where they do not, and below a few hundred samples.
+/// Stamp noise, where the differences' magnitudes show it: the 4th differences' variance in bins
+/// of speed lies on a line in the squared rate, steeply enough to be told from the bins' scatter,
+/// and the 8th differences' slope agrees (motion's leak into them grows with the speed too, but
+/// falls with the order, while white noise's does not). nullopt where they do not, and below a few
+/// hundred samples.
 std::optional<StampNoise> FindStampNoise(const DifferenceMagnitudes& magnitudes);
 
 /// The noise σ per coordinate along the samples: the data's level, raised over blocks of
@@ -91,20 +93,25 @@ class NoiseProfile {
   Eigen::VectorXd Over(Eigen::Index first, Eigen::Index count) const;
   /// The data's level.
   const Eigen::VectorXd& level() const { return level_; }
-  /// Samples where σ exceeds the level in some coordinate.
+  /// Samples in blocks raised above the base (the level, or the stamp noise's σ) in some coordinate.
   Eigen::Index raised_samples() const { return raised_samples_; }
-  /// The largest σ per coordinate (the level where nothing is raised).
+  /// The largest σ per coordinate, never below the level (the level where nothing is raised).
   const Eigen::VectorXd& maximum() const { return maximum_; }
   /// The stamp noise found, if any.
   const std::optional<StampNoise>& stamp_noise() const { return stamp_noise_; }
   /// Whether σ differs from the level anywhere (raised, or stamp noise).
   bool varies() const { return cumulative_.size() > 0; }
+  /// Whether block b (samples [b·kBlock, (b + 1)·kBlock)) was raised above the base.
+  bool BlockRaised(Eigen::Index b) const {
+    return b >= 0 && b < static_cast<Eigen::Index>(raised_blocks_.size()) && raised_blocks_[static_cast<size_t>(b)];
+  }
 
  private:
   Eigen::VectorXd level_, maximum_;
   std::optional<StampNoise> stamp_noise_;
   Eigen::MatrixXd cumulative_;  // (m + 1) x d: Σ σ² over the samples before each row; empty: the level
   Eigen::Index raised_samples_ = 0;
+  std::vector<char> raised_blocks_;
 };
 
 }  // namespace cheval::cheb::internal

@@ -331,6 +331,18 @@ TEST(StampNoise, SamplesOffTheirStampsAreWeighedByTheirRate) {
   }
 }
 
+// A coordinate that hardly moves (a thousandth of the others' motion) weighs its bins a million
+// times more than the others: the line is still found (its normal equations are solved scaled).
+TEST(StampNoise, IsFoundBesideACoordinateThatHardlyMoves) {
+  auto flat = [](double t, Eigen::Vector3d* p, Eigen::Vector3d* v) {
+    Swing(t, p, v);
+    (*p)[2] *= 1e-3;
+    (*v)[2] *= 1e-3;
+  };
+  const Motion s = Sample(flat, 20.0, 200.0, 0.0, 0.0, 4, 3e-4);
+  EXPECT_NEAR(FitCurve(s.stamps, s.positions).stamp_noise_s(), 3e-4, 0.6e-4);
+}
+
 // No stamp noise where there is none: white noise from none to 0.5 mm, samples taken at jittered
 // times that their stamps record (uneven, not wrong), a tremor, a 20 Hz recording.
 TEST(StampNoise, IsNotFoundWhereThereIsNone) {

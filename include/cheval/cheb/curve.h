@@ -209,9 +209,10 @@ class Curve {
   const std::vector<CurveSegment>& segments() const { return segments_; }
   /// The noise σ per coordinate used to choose degrees (estimated or given): the recording's level.
   const Eigen::VectorXd& noise_sigma() const { return noise_sigma_; }
-  /// Where stretches of the samples are clearly noisier than that level, the windows there were
-  /// tested against their own (docs/velocity.md, "Noise profile"): how many samples, and the
-  /// largest σ per coordinate (noise_sigma where none is).
+  /// Where stretches of the samples are clearly noisier than that level (or than the stamp noise's
+  /// σ, stamp_noise_s), the windows there were tested against their own (docs/velocity.md, "Noise
+  /// profile"): how many samples, and the largest σ per coordinate of the profile (noise_sigma where
+  /// it is the level throughout, never below it).
   Eigen::Index noisier_samples() const { return noisier_samples_; }
   const Eigen::VectorXd& noise_sigma_max() const { return noise_sigma_max_.size() > 0 ? noise_sigma_max_ : noise_sigma_; }
   /// Where the samples scatter in proportion to their rate, as stamps off by white errors make them
