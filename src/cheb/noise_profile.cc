@@ -189,15 +189,19 @@ NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitu
     : level_(level), maximum_(level), stamp_noise_(FindStampNoise(magnitudes)) {
   const Eigen::Index d = level.size();
   // The variance the blocks are judged against, per sample: the level's, or the stamp noise's.
-  // `base` holds its running sums ((m + 1) x d); empty for the level.
-  Eigen::MatrixXd base;
-  auto base_at = [&](Eigen::Index i) -> Eigen::RowVectorXd {
-    return (stamp_noise_->intercept + stamp_noise_->variance * magnitudes.rates().row(i).transpose().cwiseAbs2())
-        .transpose();
+  // `base` holds the latter's running sums ((m + 1) x d); empty for the level.
+  const Eigen::VectorXd level_variance = level.cwiseAbs2();
+  auto base_at = [&](Eigen::Index i, Eigen::Index c) {
+    if (!stamp_noise_) return level_variance[c];
+    const double rate = magnitudes.rates()(i, c);
+    return stamp_noise_->intercept[c] + stamp_noise_->variance * (rate * rate);
   };
+  Eigen::MatrixXd base;
   if (stamp_noise_) {
     base = Eigen::MatrixXd::Zero(m + 1, d);
-    for (Eigen::Index i = 0; i < m; ++i) base.row(i + 1) = base.row(i) + base_at(i);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      for (Eigen::Index c = 0; c < d; ++c) base(i + 1, c) = base(i, c) + base_at(i, c);
+    }
   }
   // The base's RMS σ over samples [from, to).
   auto base_over = [&](Eigen::Index from, Eigen::Index to) -> Eigen::VectorXd {
@@ -220,6 +224,7 @@ NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitu
     return false;
   };
   const Eigen::Index blocks = (m + kBlock - 1) / kBlock;
+  Eigen::VectorXd largest = Eigen::VectorXd::Zero(d);  // the largest variance per coordinate
   Eigen::MatrixXd bursts = Eigen::MatrixXd::Zero(blocks, d);
   for (Eigen::Index b = 0; b < blocks; ++b) {
     const Eigen::Index begin = b * kBlock, end = std::min(m, begin + kBlock);
@@ -243,41 +248,33 @@ NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitu
     for (Eigen::Index k = std::max<Eigen::Index>(0, b - 1); k <= std::min(blocks - 1, b + 1); ++k) {
       local = local.cwiseMax(bursts.row(k).transpose());
     }
-    // Raised, a block takes the local σ: the level's as it is, the stamp noise's as the factor it
-    // stands above the pool's RMS, which keeps its course with the speed.
-    // Where the base is 0 over the pool (no noise of its own, no motion), the local σ is taken as
-    // it is.
-    Eigen::RowVectorXd factor = Eigen::RowVectorXd::Ones(d), own = Eigen::RowVectorXd::Zero(d);
+    // A sample's variance is base · factor² + own. Raised over stamp noise, a block keeps the
+    // base's course with the speed, scaled by the factor the local σ stands above the pool's RMS;
+    // raised over the level (or over a base of 0: no noise of its own, no motion there), it takes
+    // the local σ as it is.
+    Eigen::VectorXd factor = Eigen::VectorXd::Ones(d), own = Eigen::VectorXd::Zero(d);
     bool raised = false;
     for (Eigen::Index c = 0; c < d; ++c) {
-      if (local[c] > threshold[c]) {
-        if (pooled[c] > 0.0) {
-          factor[c] = local[c] / pooled[c];
-        } else {
-          own[c] = local[c] * local[c];
-        }
-        raised = true;
+      if (!(local[c] > threshold[c])) continue;
+      raised = true;
+      if (stamp_noise_ && pooled[c] > 0.0) {
+        factor[c] = local[c] / pooled[c];
+      } else {
+        factor[c] = 0.0;
+        own[c] = local[c] * local[c];
       }
     }
     if (raised) raised_samples_ += end - begin;
     raised_blocks_.push_back(raised ? 1 : 0);
-    if (base.size() == 0) {
-      Eigen::RowVectorXd variance = level.cwiseAbs2().transpose();
-      for (Eigen::Index c = 0; c < d; ++c) {
-        if (local[c] > threshold[c]) {
-          variance[c] = local[c] * local[c];
-          maximum_[c] = std::max(maximum_[c], local[c]);
-        }
-      }
-      for (Eigen::Index i = begin; i < end; ++i) cumulative_.row(i + 1) = cumulative_.row(i) + variance;
-      continue;
-    }
     for (Eigen::Index i = begin; i < end; ++i) {
-      const Eigen::RowVectorXd variance = base_at(i).cwiseProduct(factor.cwiseAbs2()) + own;
-      maximum_ = maximum_.cwiseMax(variance.transpose().cwiseSqrt());
-      cumulative_.row(i + 1) = cumulative_.row(i) + variance;
+      for (Eigen::Index c = 0; c < d; ++c) {
+        const double variance = base_at(i, c) * factor[c] * factor[c] + own[c];
+        largest[c] = std::max(largest[c], variance);
+        cumulative_(i + 1, c) = cumulative_(i, c) + variance;
+      }
     }
   }
+  maximum_ = maximum_.cwiseMax(largest.cwiseSqrt());
   if (raised_samples_ == 0 && !stamp_noise_) cumulative_.resize(0, 0);
 }
 
