@@ -109,6 +109,9 @@ Raises ComputeError for a stamp outside the data by more than `tolerance` second
                              "RMS error (s) of the stamps where the samples scatter in proportion to their rate, "
                              "as stamps off by white errors make them; 0 where they do not (docs/velocity.md, "
                              "\"Stamp noise\").")
+      .def_property_readonly("resolution", &cheb::Curve::resolution,
+                             "Per coordinate, the step the values were rounded to (0 where they were not); an "
+                             "estimated noise sigma is at least step/sqrt(12) (docs/velocity.md, \"Rounded positions\").")
       .def_property_readonly("residual_rms", &cheb::Curve::residual_rms, "RMS of the fit residuals per coordinate.")
       .def_property_readonly("stored_values", &cheb::Curve::stored_values,
                              "Sum over windows of (degree + 1) per coordinate.")

@@ -146,6 +146,21 @@ class VelocityTest(unittest.TestCase):
         self.assertEqual(cheval.velocity(self.measured)["curve"].stamp_noise_s, 0.0)
 
 
+    def test_rounded_positions_are_said(self):
+        # Slow motion at 500 Hz rounded to the millimetre: a staircase, fitted as motion.
+        t = np.arange(5000) / 500.0
+        stamps = np.round(t * 1e9).astype(np.int64)
+        positions = np.column_stack([0.05 * np.sin(0.5 * t), 0.03 * np.cos(0.4 * t), 0.02 * np.sin(0.3 * t)])
+        truth = np.column_stack([0.025 * np.cos(0.5 * t), -0.012 * np.sin(0.4 * t), 0.006 * np.cos(0.3 * t)])
+        rounded = {"stamps": stamps, "positions": np.round(positions, 3)}
+        out = cheval.velocity(rounded)
+        np.testing.assert_allclose(out["curve"].resolution, [1e-3] * 3, rtol=1e-9)
+        central = cheval.velocity(rounded, method="central")
+        self.assertLess(rmse(out["velocities"], truth), 0.1 * rmse(central["velocities"], truth))
+        np.testing.assert_array_equal(cheval.velocity({"stamps": stamps, "positions": positions})["curve"].resolution,
+                                      [0.0] * 3)
+
+
 class FitTest(unittest.TestCase):
     def test_a_polynomial_is_fitted_and_differentiated_exactly(self):
         stamps = np.arange(0, 2001, dtype=np.int64) * 1_000_000  # 2 s at 1 kHz

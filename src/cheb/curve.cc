@@ -65,8 +65,8 @@ using internal::kMaxGramCondition;
 class WindowFitter {
  public:
   WindowFitter(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const internal::NoiseProfile& noise,
-               const CurveOptions& options)
-      : t_(t), z_(z), noise_(noise), options_(options) {}
+               const CurveOptions& options, const Eigen::VectorXd& rounding)
+      : t_(t), z_(z), noise_(noise), options_(options), rounding_(rounding) {}
 
   // Fits the window of core [a, b] inside segment [segment_begin, segment_end]. Returns nullopt
   // when the series is not resolved and splitting is allowed.
@@ -218,6 +218,7 @@ class WindowFitter {
       if (missed != nullptr) *missed = true;
       return std::nullopt;
     }
+    LowerBelowRounding(tw, zw, sigma, *cholesky, probe, &window);
     if (arbitrate) *undecided = true;
     if (reusable != nullptr) *reusable = !may_split && stride < 2 && !lowered && resolved && consistent;
     window.verdict = (resolved || arbitrate) && consistent ? WindowVerdict::kResolved : WindowVerdict::kUnresolved;
@@ -335,6 +336,39 @@ class WindowFitter {
       passes = passes && window->lack_of_fit[c] <= kLackOfFitLimit;
     }
     return passes;
+  }
+
+  // Values rounded to a lattice (Curve::resolution) whose differences read less noise than the
+  // rounding's q/sqrt(12) lie on a staircase: their error is correlated over many samples, and
+  // cross-validation follows it. A coordinate tested against that rounding level whose residual
+  // lies clearly below it takes the highest lower degree of the grid whose residual does not.
+  void LowerBelowRounding(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
+                          const Eigen::VectorXd& sigma, const NestedCholesky& cholesky, const NormalEquations& probe,
+                          CurveWindow* window) const {
+    const Eigen::Index m = t.size();
+    bool lowered = false;
+    std::optional<Centred> centred;
+    for (Eigen::Index c = 0; c < z.cols(); ++c) {
+      if (!internal::AtRoundingLevel(sigma[c], rounding_[c])) continue;
+      // A plain two-sided χ² test: the margin on σ (kNoiseMargin) guards only the upper side.
+      const double unmargined = sigma[c] / kNoiseMargin;
+      auto score = [&](int degree) {
+        if (!centred) centred = Centre(probe, z);
+        return centred->LackOfFit(cholesky, degree, c, m, unmargined);
+      };
+      if (score(window->degrees[c]) >= -kLackOfFitLimit) continue;
+      const std::vector<int> grid = DegreeGrid(window->degrees[c]);
+      for (auto it = grid.rbegin(); it != grid.rend(); ++it) {
+        if (*it >= window->degrees[c]) continue;
+        window->degrees[c] = *it;
+        lowered = true;
+        if (score(*it) >= -kLackOfFitLimit) break;
+      }
+    }
+    if (lowered) {
+      SetDegrees(cholesky, probe, window);
+      LackOfFit(t, z, sigma, window);
+    }
   }
 
   // The window's series at its per-coordinate degrees: leading blocks of one factorisation.
@@ -632,6 +666,7 @@ class WindowFitter {
   const Eigen::MatrixXd& z_;
   const internal::NoiseProfile& noise_;
   const CurveOptions& options_;
+  Eigen::VectorXd rounding_;
 };
 
 // A window accepted while its residual is above the noise (lack-of-fit score above kSplitScore in
@@ -966,6 +1001,14 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     if (t[i] - t[i - 1] > gap) gaps.push_back(i - 1);
   }
 
+  // Values rounded to a lattice carry its noise, q/sqrt(12), also where the differences see none
+  // (a staircase: motion slower than a step a sample); an estimate is floored there.
+  curve.resolution_ = Eigen::VectorXd::Zero(z.cols());
+  for (Eigen::Index c = 0; c < z.cols(); ++c) curve.resolution_[c] = internal::FindResolution(z.col(c));
+  auto floored = [&](Eigen::VectorXd sigma) {
+    return sigma.cwiseMax(curve.resolution_ / std::sqrt(12.0)).eval();
+  };
+
   // Jumps and glitches (CurveOptions::robust): outliers leave the fit, jumps split it.
   internal::Jumps jumps;
   Eigen::VectorXd noise;  // of the samples split at the gaps
@@ -977,7 +1020,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   if (options.robust) {
     if (!options.noise_sigma) magnitudes.emplace(t, z, gaps, threads);
     noise = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
-                                : magnitudes->Sigma(0, m);
+                                : floored(magnitudes->Sigma(0, m));
     if (magnitudes) before.emplace(noise, *magnitudes, m);
     jumps = internal::FindJumps(t, z, gaps, noise, before ? &*before : nullptr, threads);
   }
@@ -1044,7 +1087,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   if (!options.noise_sigma && (found || !magnitudes)) magnitudes.emplace(t, z, cuts, threads);
   curve.noise_sigma_ = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
                        : noise.size() > 0 && !found ? noise
-                                                    : magnitudes->Sigma(0, fitted_count);
+                                                    : floored(magnitudes->Sigma(0, fitted_count));
   // A noise σ given is taken everywhere; an estimated one is raised over stretches that are clearly
   // noisier than the data as a whole.
   const internal::NoiseProfile profile =
@@ -1056,7 +1099,8 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   curve.noisier_samples_ = profile.raised_samples();
   if (profile.varies()) curve.noise_sigma_max_ = profile.maximum();
   if (profile.stamp_noise()) curve.stamp_noise_s_ = std::sqrt(profile.stamp_noise()->variance);
-  const WindowFitter fitter(t, z, profile, options);
+  const Eigen::VectorXd rounding = curve.resolution_ / std::sqrt(12.0);
+  const WindowFitter fitter(t, z, profile, options, rounding);
 
   // Segment boundaries [starts[k], starts[k+1]), with whether each segment ends at a jump; a
   // segment with one distinct stamp joins the neighbour across the shorter gap.
@@ -1201,7 +1245,8 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     internal::ParallelFor(segment_count, threads, [&](int k) {
       segment_runs[static_cast<size_t>(k)] = internal::LocalRegressionRuns(
           t, z, starts[k], starts[k + 1], curve.segments_[k], local ? window_values : fit_values,
-          local ? window_rates : fit_rates, fit_values, fit_rates, local ? &local_samples[k] : nullptr, profile);
+          local ? window_rates : fit_rates, fit_values, fit_rates, local ? &local_samples[k] : nullptr, profile,
+          rounding);
     });
     std::vector<LocalRun> regression;
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
@@ -1482,6 +1527,10 @@ void Curve::EvaluateMany(std::span<const int64_t> stamps_ns, int order, Eigen::M
   internal::ParallelRanges(n, parts, evaluate);
 }
 
+bool Curve::AtRounding(Eigen::Index c) const {
+  return c >= 0 && c < resolution_.size() && internal::AtRoundingLevel(noise_sigma_[c], resolution_[c] / std::sqrt(12.0));
+}
+
 Curve Curve::FromParts(int64_t origin_ns, std::vector<CurveSegment> segments, Eigen::VectorXd noise_sigma,
                        Eigen::VectorXd residual_rms) {
   if (segments.empty()) throw std::invalid_argument("Curve::FromParts: no segments");
@@ -1510,6 +1559,7 @@ Curve Curve::FromParts(int64_t origin_ns, std::vector<CurveSegment> segments, Ei
   curve.segments_ = std::move(segments);
   curve.noise_sigma_ = std::move(noise_sigma);
   curve.residual_rms_ = std::move(residual_rms);
+  curve.resolution_ = Eigen::VectorXd::Zero(d);
   return curve;
 }
 

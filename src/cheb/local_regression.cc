@@ -339,7 +339,8 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
                                           Eigen::Index last, const CurveSegment& segment,
                                           const Eigen::MatrixXd& window_values, const Eigen::MatrixXd& window_rates,
                                           const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
-                                          const LocalSamples* local, const NoiseProfile& noise) {
+                                          const LocalSamples* local, const NoiseProfile& noise,
+                                          const Eigen::VectorXd& rounding) {
   std::vector<LocalRun> runs;
   const std::vector<CurveWindow>& windows = segment.windows;
   const Eigen::Index n = last - first, d = z.cols();
@@ -462,6 +463,7 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
       if (!scores) break;
       for (Eigen::Index c = 0; c < d; ++c) {
         if (rung > 0 && !biased[static_cast<size_t>(c)]) continue;
+        if (AtRoundingLevel(sigma[c], rounding[c])) continue;  // a staircase's errors are not white
         const StretchScores::Choice choice = scores->Choose(c, sigma[c]);
         chosen[static_cast<size_t>(c)] = choice.candidate;
         biased[static_cast<size_t>(c)] = choice.biased_pilot;

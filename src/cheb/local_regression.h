@@ -47,11 +47,14 @@ bool RegressionMayGain(const CurveWindow& window);
 /// the segment's, `window_values` and `window_rates` (m x d) the windows' fit at them,
 /// `fit_values` and `fit_rates` the present curve's (the local interpolant's where it took over),
 /// `local` the segment's local samples (none: the windows' fit throughout), `noise` the curve's
-/// noise profile (σ per stretch: its RMS over the stretch).
+/// noise profile (σ per stretch: its RMS over the stretch), `rounding` per coordinate q/sqrt(12) of
+/// rounded values (0: not rounded). A coordinate whose σ over a stretch is the rounding's keeps its
+/// rate there: its errors form a staircase, which the scores, made for white noise, would follow.
 std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                           Eigen::Index last, const CurveSegment& segment,
                                           const Eigen::MatrixXd& window_values, const Eigen::MatrixXd& window_rates,
                                           const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
-                                          const LocalSamples* local, const NoiseProfile& noise);
+                                          const LocalSamples* local, const NoiseProfile& noise,
+                                          const Eigen::VectorXd& rounding);
 
 }  // namespace cheval::cheb::internal

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 namespace cheval::cheb::internal {
@@ -37,6 +38,16 @@ constexpr double kOrderAgreement = 1.5;
 // Weights come from the fitted variances, floored at this fraction of a bin's own: a line through
 // zero at a noise-free recording's slow end would otherwise give its bins unbounded weight.
 constexpr double kWeightFloor = 0.25;
+
+// Rounded values (FindResolution). A difference of two values read from decimals lies within
+// kResolutionUlps units in the last place of the largest of a multiple of the step, k steps k times
+// the step's own error; the lattice must show within kLatticeTolerance of the step, the step
+// stand kMinSteps such units above them (else any values would do), and at least
+// kMinResolutionSteps differences be steps (a coordinate that hardly moves says nothing).
+constexpr double kResolutionUlps = 4.0;
+constexpr double kLatticeTolerance = 1e-3;
+constexpr double kMinSteps = 1e3;
+constexpr Eigen::Index kMinResolutionSteps = 8;
 
 // The bins' variances σ_b² against their mean squared rate u_b, fitted as s_c² + τ²·u_b by least
 // squares weighted by the bins' scatter (iterated on the fitted variances).
@@ -181,6 +192,37 @@ std::optional<StampNoise> FindStampNoise(const DifferenceMagnitudes& magnitudes)
   // The lower of the two: what leaks of the motion only ever adds.
   const SpeedLine& line = eighth->slope < fourth->slope ? *eighth : *fourth;
   return StampNoise{line.slope, line.intercept.cwiseMax(0.0)};
+}
+
+double FindResolution(const Eigen::Ref<const Eigen::VectorXd>& z) {
+  double scale = 0.0;
+  for (const double value : z) {
+    if (!std::isfinite(value)) return 0.0;
+    scale = std::max(scale, std::abs(value));
+  }
+  // Two values read from decimals differ from a multiple of their step by about a unit in the
+  // last place of the largest; the step itself is the smallest difference, to that unit too.
+  const double slack = kResolutionUlps * std::numeric_limits<double>::epsilon() * scale;
+  double q = std::numeric_limits<double>::infinity();
+  Eigen::Index steps = 0;
+  for (Eigen::Index i = 1; i < z.size(); ++i) {
+    const double difference = std::abs(z[i] - z[i - 1]);
+    if (difference <= slack) continue;
+    ++steps;
+    q = std::min(q, difference);
+  }
+  if (steps < kMinResolutionSteps || !(q >= kMinSteps * slack)) return 0.0;
+  double total = 0.0, total_steps = 0.0;
+  for (Eigen::Index i = 1; i < z.size(); ++i) {
+    const double difference = std::abs(z[i] - z[i - 1]);
+    if (difference <= slack) continue;
+    // k steps carry k times the step's own error; where that nears the step, no lattice can be told.
+    const double k = std::round(difference / q), tolerance = (k + 1.0) * slack;
+    if (tolerance > kLatticeTolerance * q || std::abs(difference - k * q) > tolerance) return 0.0;
+    total += difference;
+    total_steps += k;
+  }
+  return total / total_steps;  // the step from every difference, not from the smallest alone
 }
 
 NoiseProfile::NoiseProfile(const Eigen::VectorXd& level) : level_(level), maximum_(level) {}

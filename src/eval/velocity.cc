@@ -362,6 +362,7 @@ std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimat
     j["noise_sigma_max_m"] = std::vector<double>(curve.noise_sigma_max().data(), curve.noise_sigma_max().data() + 3);
     j["noisier_samples"] = curve.noisier_samples();
     j["stamp_noise_s"] = curve.stamp_noise_s();
+    j["position_resolution_m"] = std::vector<double>(curve.resolution().data(), curve.resolution().data() + 3);
     if (estimate.rounded_stamps) {
       j["rounded_stamps"] = {{"resolution_s", estimate.rounded_stamps->resolution_s()},
                              {"rate_hz", estimate.rounded_stamps->rate_hz()}};

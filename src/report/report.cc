@@ -140,6 +140,12 @@ Json FitDiagnostics(const cheb::Curve& curve, const Clock& clock, std::size_t ma
                                                       curve.noise_sigma_max().data() + curve.noise_sigma_max().size())},
               {"noisier_samples", curve.noisier_samples()},
               {"stamp_noise_s", curve.stamp_noise_s()},
+              {"resolution", std::vector<double>(curve.resolution().data(), curve.resolution().data() + curve.resolution().size())},
+              {"at_rounding", [&curve] {
+                 std::vector<bool> at(static_cast<size_t>(curve.dimension()));
+                 for (int c = 0; c < curve.dimension(); ++c) at[static_cast<size_t>(c)] = curve.AtRounding(c);
+                 return at;
+               }()},
               {"residual_rms", std::vector<double>(residual.data(), residual.data() + residual.size())},
               {"unresolved_windows", curve.unresolved_windows()},
               {"local_samples", curve.local_samples()}};

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -176,7 +177,8 @@ TEST_F(CliTest, VelocityFromNoisyPositions) {
   EXPECT_LT(cheb, 0.01 * diff) << cheb << " vs central " << diff;
   const nlohmann::json j = nlohmann::json::parse(Slurp(Path("v.json")));
   for (const char* key : {"method", "windows", "degrees", "noise_sigma_m", "noise_sigma_max_m", "noisier_samples",
-                          "stamp_noise_s", "residual_rmse_m", "compression_ratio", "seconds"}) {
+                          "stamp_noise_s", "position_resolution_m", "residual_rmse_m", "compression_ratio",
+                          "seconds"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_NEAR(j["noise_sigma_m"][0].get<double>(), 0.0005, 0.0001);
@@ -213,6 +215,41 @@ double ColumnRmse(const std::string& estimate, const std::string& truth, int fir
     ++n;
   }
   return n > 0 ? std::sqrt(sum / n) : 1e9;
+}
+
+// Slow motion at 500 Hz written to the millimetre (docs/velocity.md, "Rounded positions"): a
+// staircase that is said, with its step, and fitted as motion.
+TEST_F(CliTest, VelocityOfRoundedPositionsSaysSo) {
+  std::ofstream measured(Path("r.txt")), truth(Path("rt.txt"));
+  for (int i = 0; i < 5000; ++i) {
+    const double t = 100.0 + i / 500.0;
+    const double p[3] = {0.05 * std::sin(0.5 * t), 0.03 * std::cos(0.4 * t), 0.02 * std::sin(0.3 * t)};
+    const double v[3] = {0.025 * std::cos(0.5 * t), -0.012 * std::sin(0.4 * t), 0.006 * std::cos(0.3 * t)};
+    measured << fmt::format("{:.4f} {:.3f} {:.3f} {:.3f} 0 0 0 1\n", t, p[0], p[1], p[2]);
+    truth << fmt::format("{:.4f} {} {} {} 0 0 0 1 {} {} {}\n", t, p[0], p[1], p[2], v[0], v[1], v[2]);
+  }
+  measured.close();
+  truth.close();
+  RunResult run = Cheval("velocity " + Path("r.txt") + " -o " + Path("rv.txt") + " --json " + Path("rv.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("rounded positions move less than their step between samples in x (to 1 mm), y (to 1 mm), "
+                         "z (to 1 mm)"),
+            std::string::npos)
+      << run.err;
+  const nlohmann::json j = nlohmann::json::parse(Slurp(Path("rv.json")));
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(j["position_resolution_m"][c].get<double>(), 1e-3, 1e-12);
+    EXPECT_NEAR(j["noise_sigma_m"][c].get<double>(), 1e-3 / std::sqrt(12.0), 1e-12);
+  }
+  EXPECT_EQ(j["jumps"].get<int>() + j["steps"].get<int>() + j["outliers"].get<int>(), 0);
+  RunResult central = Cheval("velocity " + Path("r.txt") + " --method central -o " + Path("rc.txt"));
+  ASSERT_EQ(central.exit_code, 0) << central.err;
+  const double cheb = VelocityRmse(Path("rv.txt"), Path("rt.txt")), diff = VelocityRmse(Path("rc.txt"), Path("rt.txt"));
+  EXPECT_LT(cheb, 0.1 * diff) << cheb << " vs central " << diff;
+  // Positions not rounded say nothing of it.
+  RunResult plain = Cheval("velocity " + Path("rt.txt") + " --format tumv -o " + Path("rp.txt"));
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_EQ(plain.err.find("rounded positions"), std::string::npos) << plain.err;
 }
 
 TEST_F(CliTest, VelocityAngularFromNoisyOrientations) {

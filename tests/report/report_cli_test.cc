@@ -151,6 +151,11 @@ TEST_F(ReportCliTest, FitDiagnosticsOfTheReference) {
   ASSERT_EQ(fit["noise_sigma_max"].size(), 3u);
   EXPECT_TRUE(fit.contains("noisier_samples"));
   EXPECT_TRUE(fit.contains("stamp_noise_s"));
+  ASSERT_EQ(fit["resolution"].size(), 3u);  // the simulator's positions are not rounded
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_EQ(fit["resolution"][axis].get<double>(), 0.0);
+    EXPECT_FALSE(fit["at_rounding"][axis].get<bool>());
+  }
   for (const Json& w : fit["windows"]) {
     if (!w.contains("residual_rms")) continue;
     ASSERT_EQ(w["noise_sigma"].size(), 3u);

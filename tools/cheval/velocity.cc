@@ -93,6 +93,16 @@ void Run(const VelocityFlags& flags) {
                "(RMS) make them; the fit takes that noise into account (docs/velocity.md, \"Stamp noise\")\n",
                flags.input, 1e3 * curve.stamp_noise_s());
   }
+  std::string staircase;
+  for (Eigen::Index c = 0; c < 3; ++c) {
+    if (curve.AtRounding(c)) staircase += fmt::format("{}{} (to {:.3g} mm)", staircase.empty() ? "" : ", ", "xyz"[c], 1e3 * curve.resolution()[c]);
+  }
+  if (!staircase.empty()) {
+    fmt::print(stderr, "cheval: note: {}: rounded positions move less than their step between samples in {}; the fit "
+               "takes the rounding's noise, step/sqrt(12), and its staircase is not taken for motion (docs/velocity.md, "
+               "\"Rounded positions\")\n",
+               flags.input, staircase);
+  }
   size_t windows = 0;
   int min_degree = curve.segments().front().windows.front().degrees.front(), max_degree = min_degree;
   for (const cheb::CurveSegment& segment : curve.segments()) {

@@ -219,6 +219,12 @@ class Curve {
   /// (docs/velocity.md, "Stamp noise"): the RMS of those errors in seconds, and the windows were
   /// tested against that noise; 0 where no such scatter was found (or noise_sigma was given).
   double stamp_noise_s() const { return stamp_noise_s_; }
+  /// Per coordinate, the step q the values were rounded to, 0 where they were not (docs/velocity.md,
+  /// "Rounded positions"); an estimated noise σ is at least q/sqrt(12), the rounding's.
+  const Eigen::VectorXd& resolution() const { return resolution_; }
+  /// Whether coordinate c's estimated noise σ is the rounding's: its values move less than a step
+  /// from sample to sample (a staircase), and the differences read less noise than the rounding.
+  bool AtRounding(Eigen::Index c) const;
   /// Root mean square of the fit residuals over the samples fitted (outliers left out), per coordinate.
   const Eigen::VectorXd& residual_rms() const { return residual_rms_; }
   /// Total number of stored values (Σ over windows of (degree + 1) per coordinate).
@@ -262,6 +268,7 @@ class Curve {
   Eigen::Index noisier_samples_ = 0;
   Eigen::VectorXd noise_sigma_max_;  // empty: noise_sigma_
   double stamp_noise_s_ = 0.0;
+  Eigen::VectorXd resolution_;  // per coordinate, 0: not rounded
   Eigen::VectorXd residual_rms_;
   std::vector<double> outlier_times_, jump_times_, step_times_;
   // Row k: the sum of the first k + 1 steps, added to values after step_times_[k].
