@@ -1336,7 +1336,7 @@ void Curve::AddSteps(double t, Row&& value) const {
   if (const Eigen::Index k = StepsBefore(t); k > 0) value += step_offsets_.row(k - 1);
 }
 
-Curve::Placement Curve::Locate(double t, double tolerance_s) const {
+const CurveSegment* Curve::FindSegment(double t, double tolerance_s) const {
   // The segment containing t (or nearest within the tolerance).
   const CurveSegment* segment = nullptr;
   for (const CurveSegment& s : segments_) {
@@ -1352,6 +1352,15 @@ Curve::Placement Curve::Locate(double t, double tolerance_s) const {
       if (left.continues && t > left.end && t < right.begin) segment = t - left.end <= right.begin - t ? &left : &right;
     }
   }
+  return segment;
+}
+
+bool Curve::Covers(int64_t stamp_ns, double tolerance_s) const {
+  return FindSegment(static_cast<double>(stamp_ns - origin_ns_) * 1e-9, tolerance_s) != nullptr;
+}
+
+Curve::Placement Curve::Locate(double t, double tolerance_s) const {
+  const CurveSegment* segment = FindSegment(t, tolerance_s);
   if (segment == nullptr) {
     throw ComputeError(fmt::format("time {:.9f} s (from the first sample) is outside the fitted data or inside a gap",
                                    t));

@@ -245,7 +245,18 @@ VelocityEstimate EstimateVelocity(const traj::TrajectoryView& trajectory, const 
       if (it != own.end() && *it == stamp) stamp = estimate.rounded_stamps->uniform_ns[static_cast<size_t>(it - own.begin())];
     }
   }
-  const std::span<const int64_t> query = !at_ns ? stamps : mapped.empty() ? *at_ns : std::span<const int64_t>(mapped);
+  std::span<const int64_t> query = !at_ns ? stamps : mapped.empty() ? *at_ns : std::span<const int64_t>(mapped);
+  std::vector<int64_t> covered;
+  if (at_ns && options.skip_uncovered) {
+    for (size_t i = 0; i < query.size(); ++i) {
+      if (curve.Covers(query[i])) {
+        covered.push_back(query[i]);
+      } else {
+        estimate.skipped.push_back(i);
+      }
+    }
+    if (!estimate.skipped.empty()) query = covered;
+  }
   Eigen::MatrixXd values, derivatives;
   curve.EvaluateMany(query, 1, &values, &derivatives);
   estimate.positions = values.transpose();
@@ -271,9 +282,15 @@ traj::Trajectory VelocityTrajectory(const traj::TrajectoryView& input, const Vel
   const std::span<const int64_t> stamps = own ? input.stamps_ns() : *at_ns;
   const bool angular = estimate.angular_velocities.cols() > 0;
   traj::Trajectory out(traj::Channels{traj::OrientationKind::kQuaternion, true, angular, true});
-  out.Reserve(static_cast<Eigen::Index>(stamps.size()));
-  for (size_t i = 0; i < stamps.size(); ++i) {
-    const auto k = static_cast<Eigen::Index>(i);
+  out.Reserve(static_cast<Eigen::Index>(stamps.size() - estimate.skipped.size()));
+  auto skipped = estimate.skipped.begin();
+  for (size_t i = 0, column = 0; i < stamps.size(); ++i) {
+    if (skipped != estimate.skipped.end() && *skipped == i) {
+      ++skipped;
+      continue;
+    }
+    const size_t r = column++;  // the estimate's column
+    const auto k = static_cast<Eigen::Index>(r);
     Eigen::Vector3d position;
     Eigen::Vector4d q(0, 0, 0, 1);
     if (own) {
@@ -286,7 +303,7 @@ traj::Trajectory VelocityTrajectory(const traj::TrajectoryView& input, const Vel
     } else {
       position = estimate.positions.col(k);
       if (!estimate.orientations.empty()) {
-        q = estimate.orientations[i].coeffs();  // the fitted orientation curve
+        q = estimate.orientations[r].coeffs();  // the fitted orientation curve
       } else if (input.has_orientation()) {
         // Slerp between the input's neighbouring orientations.
         const auto s = input.stamps_ns();
@@ -362,6 +379,7 @@ std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimat
     j["noise_sigma_max_m"] = std::vector<double>(curve.noise_sigma_max().data(), curve.noise_sigma_max().data() + 3);
     j["noisier_samples"] = curve.noisier_samples();
     j["stamp_noise_s"] = curve.stamp_noise_s();
+    j["skipped_at"] = estimate.skipped.size();
     j["position_resolution_m"] = std::vector<double>(curve.resolution().data(), curve.resolution().data() + 3);
     if (estimate.rounded_stamps) {
       j["rounded_stamps"] = {{"resolution_s", estimate.rounded_stamps->resolution_s()},

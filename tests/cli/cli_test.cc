@@ -252,6 +252,61 @@ TEST_F(CliTest, VelocityOfRoundedPositionsSaysSo) {
   EXPECT_EQ(plain.err.find("rounded positions"), std::string::npos) << plain.err;
 }
 
+// --at stamps the fit does not cover (before the first sample, after the last, in a gap) are left
+// out and said; where none is covered, exit 3 and no output.
+TEST_F(CliTest, VelocityAtStampsOutsideTheDataLeavesThemOut) {
+  ASSERT_EQ(Cheval("sim motion --kind handheld --duration 10 --noise 0.0005 --gap-count 1 --gap-seconds 1 -o " +
+                   Path("g.txt"))
+                .exit_code,
+            0);
+  std::vector<double> stamps;
+  {
+    std::ifstream in(Path("g.txt"));
+    std::string line;
+    while (std::getline(in, line)) {
+      if (!line.empty() && line[0] != '#') stamps.push_back(std::stod(line.substr(0, line.find(' '))));
+    }
+  }
+  ASSERT_GT(stamps.size(), 100u);
+  size_t gap = 1;  // the sample after the longest step
+  for (size_t i = 1; i < stamps.size(); ++i) {
+    if (stamps[i] - stamps[i - 1] > stamps[gap] - stamps[gap - 1]) gap = i;
+  }
+  ASSERT_GT(stamps[gap] - stamps[gap - 1], 0.5);
+  const double inside[3] = {stamps[10], stamps[gap / 2], stamps[gap + 20]};
+  const double outside[3] = {stamps.front() - 1.0, 0.5 * (stamps[gap - 1] + stamps[gap]), stamps.back() + 2.0};
+  {
+    std::ofstream at(Path("at_mixed.txt"));
+    at << fmt::format("{:.9f}\n{:.9f}\n{:.9f}\n{:.9f}\n{:.9f}\n{:.9f}\n", outside[0], inside[0], outside[1], inside[1],
+                      inside[2], outside[2]);
+    std::ofstream none(Path("at_none.txt"));
+    none << fmt::format("{:.9f}\n{:.9f}\n", outside[0], outside[2]);
+  }
+  RunResult run = Cheval("velocity " + Path("g.txt") + " --at " + Path("at_mixed.txt") + " -o " + Path("ga.txt") +
+                         " --json " + Path("ga.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("3 of its 6 stamps lie outside"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find(fmt::format("the first is {:.9f} s", outside[0])), std::string::npos) << run.err;
+  std::vector<double> written;
+  {
+    std::ifstream out(Path("ga.txt"));
+    std::string line;
+    while (std::getline(out, line)) {
+      if (!line.empty() && line[0] != '#') written.push_back(std::stod(line.substr(0, line.find(' '))));
+    }
+  }
+  ASSERT_EQ(written.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) EXPECT_NEAR(written[i], inside[i], 1e-6);
+  const nlohmann::json j = nlohmann::json::parse(Slurp(Path("ga.json")));
+  EXPECT_EQ(j["evaluated_at"].get<int>(), 3);
+  EXPECT_EQ(j["skipped_at"].get<int>(), 3);
+
+  RunResult none = Cheval("velocity " + Path("g.txt") + " --at " + Path("at_none.txt") + " -o " + Path("gn.txt"));
+  EXPECT_EQ(none.exit_code, 3);
+  EXPECT_NE(none.err.find("none of its 2 stamps lies within"), std::string::npos) << none.err;
+  EXPECT_FALSE(std::filesystem::exists(Path("gn.txt")));
+}
+
 TEST_F(CliTest, VelocityAngularFromNoisyOrientations) {
   ASSERT_EQ(Cheval("sim motion --kind handheld --duration 20 --noise 0.0005 --rotation-noise 0.003 -o " + Path("m.txt") +
                    " --truth " + Path("t.txt"))

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "cheval/common/error.h"
 #include "cheval/eval/velocity.h"
 #include "common.h"
 #include "progress.h"
@@ -45,7 +46,10 @@ eval::VelocityOptions ToOptions(const VelocityFlags& flags) {
 
 void Run(const VelocityFlags& flags) {
   const auto start = std::chrono::steady_clock::now();
-  const eval::VelocityOptions options = ToOptions(flags);
+  eval::VelocityOptions options = ToOptions(flags);
+  // --at another file's stamps: those the fit does not cover (an estimate that runs longer than the
+  // reference, or into its gaps) are left out and said, not an error.
+  options.skip_uncovered = !flags.at_path.empty();
   options.Validate();
   RefuseSharedPaths({flags.input, flags.format.kitti_times, flags.at_path},
                     {{"-o", flags.output}, {"--json", flags.json_path}});
@@ -55,16 +59,30 @@ void Run(const VelocityFlags& flags) {
   if (!flags.at_path.empty()) at = ReadQueryStamps(flags.at_path);
   const auto at_span = at ? std::optional<std::span<const int64_t>>(*at) : std::nullopt;
   const eval::VelocityEstimate estimate = eval::EstimateVelocity(view, options, at_span);
+  if (at && !at->empty() && estimate.skipped.size() == at->size()) {
+    throw ComputeError(fmt::format("--at {}: none of its {} stamps lies within {}'s fitted data (its samples, gaps "
+                                   "left out)",
+                                   flags.at_path, at->size(), flags.input));
+  }
   const std::string text =
       flags.output.empty()
           ? ""
           : traj::FormatTrajectory(eval::VelocityTrajectory(view, estimate, at_span).View(), traj::Format::kTumV);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::string json = eval::VelocityJson(
-      {flags.input, view.size(), options, at ? at->size() : static_cast<size_t>(view.size()), seconds}, estimate);
+      {flags.input, view.size(), options, at ? at->size() - estimate.skipped.size() : static_cast<size_t>(view.size()),
+       seconds},
+      estimate);
   if (!view.has_orientation() && !flags.output.empty()) {
     fmt::print(stderr, "cheval: warning: {} has no orientation; {} gets identity quaternions\n", flags.input,
                flags.output);
+  }
+  if (!estimate.skipped.empty()) {
+    const int64_t first = (*at)[estimate.skipped.front()];
+    fmt::print(stderr, "cheval: note: {}: {} of its {} stamps lie outside {}'s fitted data (before its first sample, "
+               "after its last, or in a gap) and were left out; the first is {}.{:09d} s\n",
+               flags.at_path, estimate.skipped.size(), at->size(), flags.input, first / 1'000'000'000,
+               std::abs(first % 1'000'000'000));
   }
   std::vector<OutputFile> files;
   if (!flags.output.empty()) files.push_back({flags.output, text});

@@ -188,6 +188,11 @@ class Curve {
   void EvaluateVelocity(int64_t stamp_ns, Eigen::Ref<Eigen::VectorXd> value, Eigen::Ref<Eigen::VectorXd> derivative,
                         double tolerance_s = 0.0) const;
 
+  /// Whether the curve is defined at `stamp_ns`: within a segment by `tolerance_s`, or between two
+  /// segments split at a jump (not before the first sample, after the last, or inside a gap). Where
+  /// it is not, Evaluate and EvaluateMany throw.
+  bool Covers(int64_t stamp_ns, double tolerance_s = 0.0) const;
+
   /// Values (n x d) and, for order >= 1 and 2, first and second derivatives (n x d) at many stamps
   /// (any order; row i belongs to stamps_ns[i]). The point-wise calls' numbers to rounding (where
   /// the CPU fuses multiply-adds, the vectorised evaluation does), several times faster: the
@@ -256,6 +261,8 @@ class Curve {
     double s = 0, ds = 0, dds = 0;
   };
   Placement Locate(double t, double tolerance_s) const;
+  // The segment holding t (Covers), nullptr where none does.
+  const CurveSegment* FindSegment(double t, double tolerance_s) const;
   void EvaluateUpTo(int64_t stamp_ns, int order, Eigen::Ref<Eigen::VectorXd> value,
                     Eigen::Ref<Eigen::VectorXd>* derivative, Eigen::Ref<Eigen::VectorXd>* second_derivative,
                     double tolerance_s) const;

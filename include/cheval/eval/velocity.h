@@ -43,6 +43,10 @@ struct VelocityOptions {
   /// Also body angular velocity from the orientations (kChebyshev: a RotationCurve fitted with the
   /// same curve options; kCentral: central differences on the group). Needs orientations.
   bool angular = false;
+  /// kChebyshev with stamps to evaluate at: leave out those the fit does not cover (before the
+  /// first sample, after the last, inside a gap: cheb::Curve::Covers) instead of throwing
+  /// ComputeError, and list them in VelocityEstimate::skipped (all of them, where none is covered).
+  bool skip_uncovered = false;
 
   /// Throws OptionError for a Savitzky–Golay window that is not an odd number >= 5 of samples or not
   /// a positive number of seconds, for angular with kSavitzkyGolay, and for a fixed Chebyshev degree
@@ -102,6 +106,9 @@ struct VelocityEstimate {
   /// kChebyshev: where the stamps were rounded from a uniform rate (RoundedUniformStamps), the
   /// uniform stamps the curves were fitted and evaluated at (at the trajectory's own stamps).
   std::optional<RoundedStamps> rounded_stamps;
+  /// With VelocityOptions::skip_uncovered: the positions in `at_ns` of the stamps left out,
+  /// ascending; the columns above belong to the others, in order.
+  std::vector<size_t> skipped;
 };
 
 /// Estimates world-frame velocity at `at_ns` (nullopt: at the trajectory's own stamps) from its
