@@ -959,6 +959,8 @@ void CurveOptions::Validate() const {
   check(min_gap_s >= 0.0, "min_gap_s", "must be non-negative, got {}", min_gap_s);
   check(!noise_sigma || (*noise_sigma >= 0.0 && std::isfinite(*noise_sigma)), "noise_sigma",
         "must be a non-negative number, got {}", noise_sigma.value_or(0.0));
+  check(resolution >= 0.0 && std::isfinite(resolution), "resolution", "must be a non-negative number, got {}",
+        resolution);
   check(end_degree >= 0, "end_degree", "must be non-negative (0: no end refinement), got {}", end_degree);
   check(threads >= 0 && threads <= internal::kMaxThreads, "threads", "must be in 0..{} (0: every core), got {}",
         internal::kMaxThreads, threads);
@@ -1004,7 +1006,9 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   // Values rounded to a lattice carry its noise, q/sqrt(12), also where the differences see none
   // (a staircase: motion slower than a step a sample); an estimate is floored there.
   curve.resolution_ = Eigen::VectorXd::Zero(z.cols());
-  for (Eigen::Index c = 0; c < z.cols(); ++c) curve.resolution_[c] = internal::FindResolution(z.col(c));
+  for (Eigen::Index c = 0; c < z.cols(); ++c) {
+    curve.resolution_[c] = options.resolution > 0.0 ? options.resolution : FindResolution(z.col(c));
+  }
   auto floored = [&](Eigen::VectorXd sigma) {
     return sigma.cwiseMax(curve.resolution_ / std::sqrt(12.0)).eval();
   };

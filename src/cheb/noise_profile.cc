@@ -1,5 +1,7 @@
 #include "noise_profile.h"
 
+#include "cheval/cheb/curve.h"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -39,7 +41,7 @@ constexpr double kOrderAgreement = 1.5;
 // zero at a noise-free recording's slow end would otherwise give its bins unbounded weight.
 constexpr double kWeightFloor = 0.25;
 
-// Rounded values (FindResolution). A difference of two values read from decimals lies within
+// Rounded values (cheb::FindResolution). A difference of two values read from decimals lies within
 // kResolutionUlps units in the last place of the largest of a multiple of the step, k steps k times
 // the step's own error; the lattice must show within kLatticeTolerance of the step, the step
 // stand kMinSteps such units above them (else any values would do), and at least
@@ -194,37 +196,6 @@ std::optional<StampNoise> FindStampNoise(const DifferenceMagnitudes& magnitudes)
   return StampNoise{line.slope, line.intercept.cwiseMax(0.0)};
 }
 
-double FindResolution(const Eigen::Ref<const Eigen::VectorXd>& z) {
-  double scale = 0.0;
-  for (const double value : z) {
-    if (!std::isfinite(value)) return 0.0;
-    scale = std::max(scale, std::abs(value));
-  }
-  // Two values read from decimals differ from a multiple of their step by about a unit in the
-  // last place of the largest; the step itself is the smallest difference, to that unit too.
-  const double slack = kResolutionUlps * std::numeric_limits<double>::epsilon() * scale;
-  double q = std::numeric_limits<double>::infinity();
-  Eigen::Index steps = 0;
-  for (Eigen::Index i = 1; i < z.size(); ++i) {
-    const double difference = std::abs(z[i] - z[i - 1]);
-    if (difference <= slack) continue;
-    ++steps;
-    q = std::min(q, difference);
-  }
-  if (steps < kMinResolutionSteps || !(q >= kMinSteps * slack)) return 0.0;
-  double total = 0.0, total_steps = 0.0;
-  for (Eigen::Index i = 1; i < z.size(); ++i) {
-    const double difference = std::abs(z[i] - z[i - 1]);
-    if (difference <= slack) continue;
-    // k steps carry k times the step's own error; where that nears the step, no lattice can be told.
-    const double k = std::round(difference / q), tolerance = (k + 1.0) * slack;
-    if (tolerance > kLatticeTolerance * q || std::abs(difference - k * q) > tolerance) return 0.0;
-    total += difference;
-    total_steps += k;
-  }
-  return total / total_steps;  // the step from every difference, not from the smallest alone
-}
-
 NoiseProfile::NoiseProfile(const Eigen::VectorXd& level) : level_(level), maximum_(level) {}
 
 NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitudes& magnitudes, Eigen::Index m)
@@ -327,3 +298,38 @@ Eigen::VectorXd NoiseProfile::Over(Eigen::Index first, Eigen::Index count) const
 }
 
 }  // namespace cheval::cheb::internal
+
+namespace cheval::cheb {
+
+double FindResolution(const Eigen::Ref<const Eigen::VectorXd>& z) {
+  double scale = 0.0;
+  for (const double value : z) {
+    if (!std::isfinite(value)) return 0.0;
+    scale = std::max(scale, std::abs(value));
+  }
+  // Two values read from decimals differ from a multiple of their step by about a unit in the
+  // last place of the largest; the step itself is the smallest difference, to that unit too.
+  const double slack = internal::kResolutionUlps * std::numeric_limits<double>::epsilon() * scale;
+  double q = std::numeric_limits<double>::infinity();
+  Eigen::Index steps = 0;
+  for (Eigen::Index i = 1; i < z.size(); ++i) {
+    const double difference = std::abs(z[i] - z[i - 1]);
+    if (difference <= slack) continue;
+    ++steps;
+    q = std::min(q, difference);
+  }
+  if (steps < internal::kMinResolutionSteps || !(q >= internal::kMinSteps * slack)) return 0.0;
+  double total = 0.0, total_steps = 0.0;
+  for (Eigen::Index i = 1; i < z.size(); ++i) {
+    const double difference = std::abs(z[i] - z[i - 1]);
+    if (difference <= slack) continue;
+    // k steps carry k times the step's own error; where that nears the step, no lattice can be told.
+    const double k = std::round(difference / q), tolerance = (k + 1.0) * slack;
+    if (tolerance > internal::kLatticeTolerance * q || std::abs(difference - k * q) > tolerance) return 0.0;
+    total += difference;
+    total_steps += k;
+  }
+  return total / total_steps;  // the step from every difference, not from the smallest alone
+}
+
+}  // namespace cheval::cheb

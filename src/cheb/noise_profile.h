@@ -69,16 +69,9 @@ struct StampNoise {
 /// hundred samples.
 std::optional<StampNoise> FindStampNoise(const DifferenceMagnitudes& magnitudes);
 
-/// The step q of the lattice a coordinate's values were rounded to (docs/velocity.md, "Rounded
-/// positions"): every difference between consecutive values is a whole multiple of q, to the
-/// rounding of doubles, and q stands well above that rounding; 0 where there is no such lattice
-/// (values not rounded, or too few distinct ones). Rounding to q is noise of σ q/sqrt(12) at
-/// least: white where the motion crosses many steps between samples, a staircase where it does
-/// not, and there the differences read no noise at all.
-double FindResolution(const Eigen::Ref<const Eigen::VectorXd>& z);
 
 /// Whether a noise σ (a profile's RMS over some samples) is the rounding's, `rounding` =
-/// q/sqrt(12) from FindResolution (0: none), to which an estimate was floored: the differences
+/// q/sqrt(12) from cheb::FindResolution (0: none), to which an estimate was floored: the differences
 /// read less, so the values lie on a staircase whose errors are correlated from sample to sample,
 /// not white. (The RMS over a stretch differs from the floor in the last bits.)
 inline bool AtRoundingLevel(double sigma, double rounding) {

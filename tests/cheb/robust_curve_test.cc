@@ -17,7 +17,6 @@
 
 #include "cheval/cheb/curve.h"
 #include "cheval/cheb/degree.h"
-#include "noise_profile.h"
 
 namespace cheval::cheb {
 namespace {
@@ -512,17 +511,17 @@ TEST(RoundedPositions, TheStepOfTheDecimalsIsFound) {
   for (const int decimals : {3, 4, 6}) {
     const Eigen::MatrixXd read = Printed(far, decimals);
     for (Eigen::Index c = 0; c < 3; ++c) {
-      EXPECT_NEAR(internal::FindResolution(read.col(c)), std::pow(10.0, -decimals), 1e-9 * std::pow(10.0, -decimals))
+      EXPECT_NEAR(FindResolution(read.col(c)), std::pow(10.0, -decimals), 1e-9 * std::pow(10.0, -decimals))
           << decimals << " decimals, coordinate " << c;
     }
   }
-  for (Eigen::Index c = 0; c < 3; ++c) EXPECT_EQ(internal::FindResolution(far.col(c)), 0.0) << c;
+  for (Eigen::Index c = 0; c < 3; ++c) EXPECT_EQ(FindResolution(far.col(c)), 0.0) << c;
   Eigen::VectorXd few = Eigen::VectorXd::Constant(100, 1.5);
   few.tail(3).array() += 1e-3;
-  EXPECT_EQ(internal::FindResolution(few), 0.0);
+  EXPECT_EQ(FindResolution(few), 0.0);
   Eigen::VectorXd nan = Printed(far, 3).col(0);
   nan[7] = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_EQ(internal::FindResolution(nan), 0.0);
+  EXPECT_EQ(FindResolution(nan), 0.0);
 }
 
 // Motion slower than a step per sample, printed to the millimetre, reads as a staircase, whose

@@ -113,12 +113,13 @@ void Run(const VelocityFlags& flags) {
   }
   std::string staircase;
   for (Eigen::Index c = 0; c < 3; ++c) {
-    if (curve.AtRounding(c)) staircase += fmt::format("{}{} (to {:.3g} mm)", staircase.empty() ? "" : ", ", "xyz"[c], 1e3 * curve.resolution()[c]);
+    if (!curve.AtRounding(c)) continue;
+    staircase += fmt::format("{}{} to {:.3g} mm", staircase.empty() ? "" : ", ", "xyz"[c], 1e3 * curve.resolution()[c]);
   }
   if (!staircase.empty()) {
-    fmt::print(stderr, "cheval: note: {}: rounded positions move less than their step between samples in {}; the fit "
-               "takes the rounding's noise, step/sqrt(12), and its staircase is not taken for motion (docs/velocity.md, "
-               "\"Rounded positions\")\n",
+    fmt::print(stderr, "cheval: note: {}: the positions are rounded ({}) and their differences read no more noise than "
+               "that rounding's, step/sqrt(12): the fit takes it as their noise, and a staircase of them is not taken "
+               "for motion (docs/velocity.md, \"Rounded positions\")\n",
                flags.input, staircase);
   }
   size_t windows = 0;

@@ -54,6 +54,11 @@ struct CurveOptions {
   double min_gap_s = 0.1;
   /// Noise standard deviation of the samples (same unit as them); nullopt = estimated from the data.
   std::optional<double> noise_sigma;
+  /// The step the values were rounded to, where the caller knows it; 0: per coordinate, the
+  /// lattice the values lie on, if any (FindResolution). An estimated σ is at least step/sqrt(12)
+  /// (docs/velocity.md, "Rounded positions"). Rotation charts of rounded quaternions lie on no
+  /// lattice of their own, and take it from the quaternions' (eval::EstimateVelocity).
+  double resolution = 0.0;
   /// The derivative of a least-squares polynomial is noisiest at the ends of its interval, and
   /// more so the higher its degree (the variance at an end grows like N⁴/m). The first and last
   /// window of every segment are therefore halved until their degree is at most end_degree (or
@@ -293,6 +298,15 @@ class Curve {
 /// Quintic smoothstep s(u) = 6u⁵ − 15u⁴ + 10u³ on u clamped to [0, 1], with ds/du and d²s/du²:
 /// the C² blending weight of overlapping fits.
 void Smoothstep(double u, double* s, double* ds, double* dds);
+
+/// The step q of the lattice `values` were rounded to (docs/velocity.md, "Rounded positions"):
+/// every difference between consecutive values is a whole multiple of q, to the rounding of
+/// doubles read from decimals, and q stands well above that rounding; 0 where there is no such
+/// lattice (values not rounded, a lattice too fine to be told, a coordinate that hardly moves, a
+/// value that is not finite). Rounding to q is noise of σ q/sqrt(12) at least: white where the
+/// motion crosses many steps between samples, a staircase where it does not, and there the
+/// differences read no noise at all.
+double FindResolution(const Eigen::Ref<const Eigen::VectorXd>& values);
 
 /// Fits `values` (m x d, d <= 4; row i sampled at stamps_ns[i]) with a Curve. Stamps need not be
 /// sorted or unique (samples are sorted by stamp; equal stamps are averaged by the least squares).
