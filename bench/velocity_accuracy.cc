@@ -7,7 +7,8 @@
 // central differences, a cubic smoothing spline with GCV (smoothing_spline.h), and one global
 // Chebyshev fit of fixed degree 400 (the C-ASE paper's choice for CARLA). Besides the simulator's
 // kinds: hand tremor on a handheld motion, velocity steps (impacts) on a noise-free legged one, a
-// vibration near a quarter of the rate, bursts of noise and stamps off by white errors.
+// vibration near a quarter of the rate, bursts of noise, stamps off by white errors and a slow
+// motion's positions written to the millimetre.
 // Ratios are against the baselines measured in the same run. A second table: body angular velocity
 // from noisy orientations.
 //   build/bench/velocity_accuracy [DATA_DIR [SEEDS [FIRST_SEED [ROWS]]]]
@@ -204,15 +205,20 @@ Case Bursts() {
                    });
 }
 
+// The simulator's handheld motion at `rate_hz`.
+sim::MotionModel Handheld(double rate_hz) {
+  sim::MotionOptions options;
+  options.kind = sim::MotionKind::kHandheld;
+  options.rate_hz = rate_hz;
+  return sim::MotionModel(options);
+}
+
 // Stamps off by white errors of 0.3 ms RMS (a recorder that stamps samples on arrival) on a
 // noise-free handheld motion at 200 Hz: each sample lies v·δ from the motion at its stamp
 // (docs/velocity.md, "Stamp noise"). Scored at the stamps against the velocity at the instants the
 // samples were taken.
 Case StampErrors() {
-  sim::MotionOptions options;
-  options.kind = sim::MotionKind::kHandheld;
-  options.rate_hz = 200;
-  const sim::MotionModel model(options);
+  const sim::MotionModel model = Handheld(200);
   const traj::Trajectory taken = sim::Measure(model, sim::MeasurementOptions{});
   std::mt19937_64 rng(12);
   std::normal_distribution<double> error(0.0, 3e-4);
@@ -223,6 +229,23 @@ Case StampErrors() {
   for (Eigen::Index i = 0; i < taken.size(); ++i) {
     const Eigen::Vector3d p = taken.positions().col(i);
     c.measured.Append(taken.stamps_ns()[i] + std::llround(1e9 * error(rng)), p.data());
+  }
+  return c;
+}
+
+// Positions written to the millimetre of a slow motion (the handheld one at a tenth of its size
+// and speed) at 1000 Hz: a staircase, about 30 samples a step, whose differences read no noise
+// (docs/velocity.md, "Rounded positions").
+Case RoundedSlow() {
+  const sim::MotionModel model = Handheld(1000);
+  const traj::Trajectory taken = sim::Measure(model, sim::MeasurementOptions{});
+  Case c;
+  c.name = "rounded 1 mm, slow";
+  c.truth = 0.1 * sim::SampleMotion(model, taken.stamps_ns()).View().velocities();
+  c.measured.Reserve(taken.size());
+  for (Eigen::Index i = 0; i < taken.size(); ++i) {
+    const Eigen::Vector3d p = (0.1e3 * taken.positions().col(i)).array().round() * 1e-3;
+    c.measured.Append(taken.stamps_ns()[i], p.data());
   }
   return c;
 }
@@ -300,7 +323,7 @@ int main(int argc, char** argv) {
       }
     }
   }
-  for (const Case& c : {Tremor(0.0005), Tremor(0.0), Impacts(), Vibration(), Bursts(), StampErrors()}) {
+  for (const Case& c : {Tremor(0.0005), Tremor(0.0), Impacts(), Vibration(), Bursts(), StampErrors(), RoundedSlow()}) {
     if (wanted(c.name)) Print(Evaluate(c.name, c.measured.View(), c.truth));
   }
   for (const char* file : {"MH_05_difficult.csv", "V1_01_easy.csv", "V1_02_medium.csv", "V2_02_medium.csv"}) {
