@@ -69,7 +69,6 @@ struct StampNoise {
 /// hundred samples.
 std::optional<StampNoise> FindStampNoise(const DifferenceMagnitudes& magnitudes);
 
-
 /// Whether a noise σ (a profile's RMS over some samples) is the rounding's, `rounding` =
 /// q/sqrt(12) from cheb::FindResolution (0: none), to which an estimate was floored: the differences
 /// read less, so the values lie on a staircase whose errors are correlated from sample to sample,

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <fmt/format.h>
@@ -78,11 +80,12 @@ void Run(const VelocityFlags& flags) {
                flags.output);
   }
   if (!estimate.skipped.empty()) {
-    const int64_t first = (*at)[estimate.skipped.front()];
+    const int64_t first = (*at)[estimate.skipped.front()];  // as the file gives it, to the nanosecond
+    const int64_t whole = first / 1'000'000'000, nanoseconds = std::abs(first % 1'000'000'000);
     fmt::print(stderr, "cheval: note: {}: {} of its {} stamps lie outside {}'s fitted data (before its first sample, "
-               "after its last, or in a gap) and were left out; the first is {}.{:09d} s\n",
-               flags.at_path, estimate.skipped.size(), at->size(), flags.input, first / 1'000'000'000,
-               std::abs(first % 1'000'000'000));
+               "after its last, or in a gap) and were left out; the first is {}{}.{:09d} s\n",
+               flags.at_path, estimate.skipped.size(), at->size(), flags.input, first < 0 && whole == 0 ? "-" : "",
+               whole, nanoseconds);
   }
   std::vector<OutputFile> files;
   if (!flags.output.empty()) files.push_back({flags.output, text});
