@@ -1006,12 +1006,13 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   // Values rounded to a lattice carry its noise, q/sqrt(12), also where the differences see none
   // (a staircase: motion slower than a step a sample); an estimate is floored there.
   curve.resolution_ = Eigen::VectorXd::Zero(z.cols());
+  curve.rounding_ = Eigen::VectorXd::Zero(z.cols());
   for (Eigen::Index c = 0; c < z.cols(); ++c) {
-    curve.resolution_[c] = options.resolution > 0.0 ? options.resolution : FindResolution(z.col(c));
+    const double q = options.resolution > 0.0 ? options.resolution : FindResolution(z.col(c));
+    curve.resolution_[c] = q;
+    if (q > 0.0 && (options.resolution > 0.0 || IsRounded(z.col(c), q))) curve.rounding_[c] = q / std::sqrt(12.0);
   }
-  auto floored = [&](Eigen::VectorXd sigma) {
-    return sigma.cwiseMax(curve.resolution_ / std::sqrt(12.0)).eval();
-  };
+  auto floored = [&](Eigen::VectorXd sigma) { return sigma.cwiseMax(curve.rounding_).eval(); };
 
   // Jumps and glitches (CurveOptions::robust): outliers leave the fit, jumps split it.
   internal::Jumps jumps;
@@ -1103,8 +1104,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   curve.noisier_samples_ = profile.raised_samples();
   if (profile.varies()) curve.noise_sigma_max_ = profile.maximum();
   if (profile.stamp_noise()) curve.stamp_noise_s_ = std::sqrt(profile.stamp_noise()->variance);
-  const Eigen::VectorXd rounding = curve.resolution_ / std::sqrt(12.0);
-  const WindowFitter fitter(t, z, profile, options, rounding);
+  const WindowFitter fitter(t, z, profile, options, curve.rounding_);
 
   // Segment boundaries [starts[k], starts[k+1]), with whether each segment ends at a jump; a
   // segment with one distinct stamp joins the neighbour across the shorter gap.
@@ -1250,7 +1250,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
       segment_runs[static_cast<size_t>(k)] = internal::LocalRegressionRuns(
           t, z, starts[k], starts[k + 1], curve.segments_[k], local ? window_values : fit_values,
           local ? window_rates : fit_rates, fit_values, fit_rates, local ? &local_samples[k] : nullptr, profile,
-          rounding);
+          curve.rounding_);
     });
     std::vector<LocalRun> regression;
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
@@ -1541,7 +1541,7 @@ void Curve::EvaluateMany(std::span<const int64_t> stamps_ns, int order, Eigen::M
 }
 
 bool Curve::AtRounding(Eigen::Index c) const {
-  return c >= 0 && c < resolution_.size() && internal::AtRoundingLevel(noise_sigma_[c], resolution_[c] / std::sqrt(12.0));
+  return c >= 0 && c < rounding_.size() && internal::AtRoundingLevel(noise_sigma_[c], rounding_[c]);
 }
 
 Curve Curve::FromParts(int64_t origin_ns, std::vector<CurveSegment> segments, Eigen::VectorXd noise_sigma,
@@ -1573,6 +1573,7 @@ Curve Curve::FromParts(int64_t origin_ns, std::vector<CurveSegment> segments, Ei
   curve.noise_sigma_ = std::move(noise_sigma);
   curve.residual_rms_ = std::move(residual_rms);
   curve.resolution_ = Eigen::VectorXd::Zero(d);
+  curve.rounding_ = Eigen::VectorXd::Zero(d);
   return curve;
 }
 

@@ -57,7 +57,8 @@ struct CurveOptions {
   /// The step the values were rounded to, where the caller knows it; 0: per coordinate, the
   /// lattice the values lie on, if any (FindResolution). An estimated σ is at least step/sqrt(12)
   /// (docs/velocity.md, "Rounded positions"). Rotation charts of rounded quaternions lie on no
-  /// lattice of their own, and take it from the quaternions' (eval::EstimateVelocity).
+  /// lattice of their own, and take it from the quaternions' (eval::EstimateVelocity). A found
+  /// lattice floors σ only where the values were rounded to it (IsRounded); a given one always.
   double resolution = 0.0;
   /// The derivative of a least-squares polynomial is noisiest at the ends of its interval, and
   /// more so the higher its degree (the variance at an end grows like N⁴/m). The first and last
@@ -230,10 +231,12 @@ class Curve {
   /// tested against that noise; 0 where no such scatter was found (or noise_sigma was given).
   double stamp_noise_s() const { return stamp_noise_s_; }
   /// Per coordinate, the step q the values were rounded to, 0 where they were not (docs/velocity.md,
-  /// "Rounded positions"); an estimated noise σ is at least q/sqrt(12), the rounding's.
+  /// "Rounded positions"). Where they were rounded to it (IsRounded), an estimated noise σ is at
+  /// least q/sqrt(12), the rounding's.
   const Eigen::VectorXd& resolution() const { return resolution_; }
-  /// Whether coordinate c's estimated noise σ is the rounding's: its values move less than a step
-  /// from sample to sample (a staircase), and the differences read less noise than the rounding.
+  /// Whether coordinate c's estimated noise σ is the rounding's: its values were rounded, and the
+  /// differences read less noise than the rounding (a staircase, or a median of 4th differences
+  /// that is itself a whole number of steps).
   bool AtRounding(Eigen::Index c) const;
   /// Root mean square of the fit residuals over the samples fitted (outliers left out), per coordinate.
   const Eigen::VectorXd& residual_rms() const { return residual_rms_; }
@@ -281,6 +284,7 @@ class Curve {
   Eigen::VectorXd noise_sigma_max_;  // empty: noise_sigma_
   double stamp_noise_s_ = 0.0;
   Eigen::VectorXd resolution_;  // per coordinate, 0: not rounded
+  Eigen::VectorXd rounding_;    // per coordinate, the floor q/sqrt(12) of σ, 0: none
   Eigen::VectorXd residual_rms_;
   std::vector<double> outlier_times_, jump_times_, step_times_;
   // Row k: the sum of the first k + 1 steps, added to values after step_times_[k].
@@ -307,6 +311,14 @@ void Smoothstep(double u, double* s, double* ds, double* dds);
 /// motion crosses many steps between samples, a staircase where it does not, and there the
 /// differences read no noise at all.
 double FindResolution(const Eigen::Ref<const Eigen::VectorXd>& values);
+
+/// Whether `values` on a lattice of step `q` (FindResolution) were rounded to it rather than lying
+/// on it by themselves: most runs of five consecutive values that change have a nonzero 4th
+/// difference. Rounding scatters the values off any cubic (a staircase's single steps where the
+/// motion is slower than a step a sample, white rounding noise where it is faster); motion that
+/// lies on the lattice by itself (a simulator's constant velocity of whole steps a sample, stops
+/// and starts) is a polynomial between its corners, and its values are exact.
+bool IsRounded(const Eigen::Ref<const Eigen::VectorXd>& values, double q);
 
 /// Fits `values` (m x d, d <= 4; row i sampled at stamps_ns[i]) with a Curve. Stamps need not be
 /// sorted or unique (samples are sorted by stamp; equal stamps are averaged by the least squares).
