@@ -339,8 +339,8 @@ class WindowFitter {
   }
 
   // Values rounded to a lattice (Curve::resolution) whose differences read less noise than the
-  // rounding's q/sqrt(12) lie on a staircase: their error is correlated over many samples, and
-  // cross-validation follows it. A coordinate tested against that rounding level whose residual
+  // rounding's q/sqrt(12) (a staircase, or a median of whole-step differences read low) may have
+  // errors correlated over many samples, and cross-validation follows them. A coordinate tested against that rounding level whose residual
   // lies clearly below it takes the highest lower degree of the grid whose residual does not.
   void LowerBelowRounding(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
                           const Eigen::VectorXd& sigma, const NestedCholesky& cholesky, const NormalEquations& probe,
@@ -666,7 +666,7 @@ class WindowFitter {
   const Eigen::MatrixXd& z_;
   const internal::NoiseProfile& noise_;
   const CurveOptions& options_;
-  Eigen::VectorXd rounding_;
+  const Eigen::VectorXd& rounding_;  // per coordinate, Curve's floor of σ (0: none)
 };
 
 // A window accepted while its residual is above the noise (lack-of-fit score above kSplitScore in
@@ -1003,8 +1003,9 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     if (t[i] - t[i - 1] > gap) gaps.push_back(i - 1);
   }
 
-  // Values rounded to a lattice carry its noise, q/sqrt(12), also where the differences see none
-  // (a staircase: motion slower than a step a sample); an estimate is floored there.
+  // Values rounded to a lattice carry its noise, q/sqrt(12), also where the differences see less
+  // (a staircase: motion slower than a step a sample); an estimate is floored where they were
+  // rounded, not where exact motion lies on a lattice by itself (IsRounded).
   curve.resolution_ = Eigen::VectorXd::Zero(z.cols());
   curve.rounding_ = Eigen::VectorXd::Zero(z.cols());
   for (Eigen::Index c = 0; c < z.cols(); ++c) {

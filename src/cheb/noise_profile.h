@@ -71,8 +71,9 @@ std::optional<StampNoise> FindStampNoise(const DifferenceMagnitudes& magnitudes)
 
 /// Whether a noise σ (a profile's RMS over some samples) is the rounding's, `rounding` =
 /// q/sqrt(12) from cheb::FindResolution (0: none), to which an estimate was floored: the differences
-/// read less, so the values lie on a staircase whose errors are correlated from sample to sample,
-/// not white. (The RMS over a stretch differs from the floor in the last bits.)
+/// read less, on a staircase whose errors are correlated from sample to sample, or through a
+/// median of whole-step differences that reads low. (The RMS over a stretch differs from the
+/// floor in the last bits.)
 inline bool AtRoundingLevel(double sigma, double rounding) {
   return rounding > 0.0 && std::abs(sigma - rounding) <= 1e-9 * rounding;
 }

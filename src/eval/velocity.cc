@@ -267,15 +267,14 @@ VelocityEstimate EstimateVelocity(const traj::TrajectoryView& trajectory, const 
     for (Eigen::Index i = 0; i < trajectory.size(); ++i) rotations[i] = trajectory.UnitQuaternion(i);
     RotationCurveOptions rotation_options;
     rotation_options.curve = options.curve;
-    // Quaternions rounded to a step δ (TUM's four decimals) put each chart
-    // coordinate within 2δ's rounding noise (δθ = 2 Im(q̄ δq)), on no lattice of its own ("Rounded
-    // positions").
+    // Quaternions rounded to a step δ (TUM's four decimals) put each chart coordinate within 2δ's
+    // rounding noise (δθ = 2 Im(q̄ δq)), on no lattice of its own ("Rounded positions").
     if (trajectory.channels().orientation == traj::OrientationKind::kQuaternion && options.curve.resolution == 0.0) {
       double step = 0.0;  // a component that hardly moves shows none
       for (Eigen::Index k = 0; k < 4; ++k) {
         const Eigen::VectorXd component = trajectory.quaternions().row(k).transpose();
         const double q = cheb::FindResolution(component);
-        if (q > 0.0 && cheb::IsRounded(component, q)) step = std::max(step, q);
+        if (cheb::IsRounded(component, q)) step = std::max(step, q);  // false where q is 0
       }
       rotation_options.curve.resolution = 2.0 * step;
     }

@@ -252,6 +252,17 @@ TEST_F(CliTest, VelocityOfRoundedPositionsSaysSo) {
   EXPECT_EQ(plain.err.find("rounded"), std::string::npos) << plain.err;
 }
 
+// The first column (stamps in seconds) of a TUM file, comments skipped.
+std::vector<double> StampColumn(const std::string& path) {
+  std::vector<double> stamps;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line[0] != '#') stamps.push_back(std::stod(line.substr(0, line.find(' '))));
+  }
+  return stamps;
+}
+
 // --at stamps the fit does not cover (before the first sample, after the last, in a gap) are left
 // out and said; where none is covered, exit 3 and no output.
 TEST_F(CliTest, VelocityAtStampsOutsideTheDataLeavesThemOut) {
@@ -259,14 +270,7 @@ TEST_F(CliTest, VelocityAtStampsOutsideTheDataLeavesThemOut) {
                    Path("g.txt"))
                 .exit_code,
             0);
-  std::vector<double> stamps;
-  {
-    std::ifstream in(Path("g.txt"));
-    std::string line;
-    while (std::getline(in, line)) {
-      if (!line.empty() && line[0] != '#') stamps.push_back(std::stod(line.substr(0, line.find(' '))));
-    }
-  }
+  const std::vector<double> stamps = StampColumn(Path("g.txt"));
   ASSERT_GT(stamps.size(), 100u);
   size_t gap = 1;  // the sample after the longest step
   for (size_t i = 1; i < stamps.size(); ++i) {
@@ -287,14 +291,7 @@ TEST_F(CliTest, VelocityAtStampsOutsideTheDataLeavesThemOut) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.err.find("3 of its 6 stamps lie outside"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find(fmt::format("the first is {:.9f} s", outside[0])), std::string::npos) << run.err;
-  std::vector<double> written;
-  {
-    std::ifstream out(Path("ga.txt"));
-    std::string line;
-    while (std::getline(out, line)) {
-      if (!line.empty() && line[0] != '#') written.push_back(std::stod(line.substr(0, line.find(' '))));
-    }
-  }
+  const std::vector<double> written = StampColumn(Path("ga.txt"));
   ASSERT_EQ(written.size(), 3u);
   for (size_t i = 0; i < 3; ++i) EXPECT_NEAR(written[i], inside[i], 1e-6);
   const nlohmann::json j = nlohmann::json::parse(Slurp(Path("ga.json")));
