@@ -205,6 +205,15 @@ Case Bursts() {
                    });
 }
 
+// A short clip: the first half second of a hand-held motion at 100 Hz (50 samples) under 2 mm,
+// whose noise level comes from few differences (docs/velocity.md, "Residual test").
+Case ShortClip() {
+  sim::MeasurementOptions measurement;
+  measurement.noise_m = 2e-3;
+  return Perturbed("short 0.5 s, 2.0 mm", sim::MotionKind::kHandheld, 100, 0.5, measurement,
+                   [](double, Eigen::Vector3d&, Eigen::Vector3d&) {});
+}
+
 // The simulator's handheld motion at `rate_hz`.
 sim::MotionModel Handheld(double rate_hz) {
   sim::MotionOptions options;
@@ -323,7 +332,8 @@ int main(int argc, char** argv) {
       }
     }
   }
-  for (const Case& c : {Tremor(0.0005), Tremor(0.0), Impacts(), Vibration(), Bursts(), StampErrors(), RoundedSlow()}) {
+  for (const Case& c : {Tremor(0.0005), Tremor(0.0), Impacts(), Vibration(), Bursts(), StampErrors(), RoundedSlow(),
+                        ShortClip()}) {
     if (wanted(c.name)) Print(Evaluate(c.name, c.measured.View(), c.truth));
   }
   for (const char* file : {"MH_05_difficult.csv", "V1_01_easy.csv", "V1_02_medium.csv", "V2_02_medium.csv"}) {

@@ -39,6 +39,13 @@ constexpr double kLackOfFitLimit = 3.0;
 // hundreds of samples a χ² test alone would take for unresolved motion (it made the drone's body
 // rate 2–3x worse); a residual of 1.5σ (a missed tremor) still fails.
 constexpr double kNoiseMargin = 1.1;
+// The noise level is a median over the recording's differences, and scatters like a variance
+// estimate with about one degree of freedom per kSamplesPerNoiseDof samples (measured on white
+// noise: 0.16–0.22 per sample from 100 to 1,000 samples). Where that is fewer than kMarginDof, the
+// level scatters by more than the 10 % that kNoiseMargin absorbs (a relative standard deviation of
+// 1/sqrt(2k)), and a level read low would make the residual test raise degrees to fit the noise.
+constexpr double kSamplesPerNoiseDof = 6.0;
+constexpr double kMarginDof = 50.0;
 // A window that passes the lack-of-fit test with a score above this (2 standard deviations, where
 // noise consistent with the 1.1σ margin rarely comes) is compared with its halves
 // (SplitPredictsBetter). At 1 the charts of rotations, whose noise varies along them, were split
@@ -65,8 +72,8 @@ using internal::kMaxGramCondition;
 class WindowFitter {
  public:
   WindowFitter(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const internal::NoiseProfile& noise,
-               const CurveOptions& options, const Eigen::VectorXd& rounding)
-      : t_(t), z_(z), noise_(noise), options_(options), rounding_(rounding) {}
+               const CurveOptions& options, const Eigen::VectorXd& rounding, double level_dof)
+      : t_(t), z_(z), noise_(noise), options_(options), rounding_(rounding), level_dof_(level_dof) {}
 
   // Fits the window of core [a, b] inside segment [segment_begin, segment_end]. Returns nullopt
   // when the series is not resolved and splitting is allowed.
@@ -191,7 +198,9 @@ class WindowFitter {
 
     // The residual must be consistent with the noise too: a series can look resolved while the
     // motion it misses lies above the top degree the window may use. A coordinate whose residual
-    // fails at the chosen degree takes the lowest degree of the grid that passes, if any.
+    // fails at the chosen degree takes the lowest degree of the grid that passes, if any. In a
+    // short recording the noise level is itself uncertain (level_dof_), and a level read low
+    // would raise the degree to fit the noise: the raise tests against F instead of χ² there.
     window.series.interval = interval;
     SetDegrees(*cholesky, probe, &window);
     bool consistent = LackOfFit(tw, zw, sigma, &window) || !options_.lack_of_fit;
@@ -202,7 +211,7 @@ class WindowFitter {
         if (window.lack_of_fit[c] <= kLackOfFitLimit) continue;
         for (const int degree : DegreeGrid(top)) {
           if (degree <= window.degrees[c]) continue;
-          if (centred.LackOfFit(*cholesky, degree, c, m, sigma[c]) <= kLackOfFitLimit || degree == top) {
+          if (centred.LackOfFit(*cholesky, degree, c, m, sigma[c], level_dof_) <= kLackOfFitLimit || degree == top) {
             window.degrees[c] = degree;
             raised = true;
             break;
@@ -310,11 +319,17 @@ class WindowFitter {
 
   // Standard normal score of RSS/σ² against χ² with `dof` degrees of freedom (Wilson–Hilferty:
   // (X/ν)^(1/3) is nearly normal with mean 1 − 2/(9ν) and variance 2/(9ν)); 0 without freedom.
-  static double LackOfFitScore(double rss, double sigma, Eigen::Index dof) {
+  // With `sigma_dof` > 0, σ² is itself an estimate with that many degrees of freedom, and the
+  // score is that of RSS/(νσ²) against F(ν, sigma_dof) (Paulson's approximation, which reduces to
+  // Wilson–Hilferty as sigma_dof grows: Abramowitz & Stegun 26.6.15).
+  static double LackOfFitScore(double rss, double sigma, Eigen::Index dof, double sigma_dof = 0.0) {
     if (dof <= 0) return 0.0;
     sigma *= kNoiseMargin;
     const double nu = static_cast<double>(dof), v = 2.0 / (9.0 * nu);
-    return (std::cbrt(rss / (sigma * sigma) / nu) - (1.0 - v)) / std::sqrt(v);
+    const double root = std::cbrt(rss / (sigma * sigma) / nu);
+    if (sigma_dof <= 0.0) return (root - (1.0 - v)) / std::sqrt(v);
+    const double w = 2.0 / (9.0 * sigma_dof);
+    return ((1.0 - w) * root - (1.0 - v)) / std::sqrt(w * root * root + v);
   }
 
   // Residuals of a window's series at its samples: fills residual_rms and lack_of_fit; whether
@@ -388,10 +403,11 @@ class WindowFitter {
   struct Centred {
     Eigen::MatrixXd rhs;
     Eigen::RowVectorXd squares;
-    double LackOfFit(const NestedCholesky& cholesky, int degree, Eigen::Index c, Eigen::Index m, double sigma) const {
+    double LackOfFit(const NestedCholesky& cholesky, int degree, Eigen::Index c, Eigen::Index m, double sigma,
+                     double sigma_dof = 0.0) const {
       const Eigen::VectorXd coefficients = cholesky.Solve(degree, rhs.col(c));
       const double rss = std::max(0.0, squares[c] - coefficients.dot(rhs.col(c).head(degree + 1)));
-      return LackOfFitScore(rss, sigma, m - degree - 1);
+      return LackOfFitScore(rss, sigma, m - degree - 1, sigma_dof);
     }
   };
   static Centred Centre(const NormalEquations& probe, const Eigen::Ref<const Eigen::MatrixXd>& z) {
@@ -667,6 +683,9 @@ class WindowFitter {
   const internal::NoiseProfile& noise_;
   const CurveOptions& options_;
   const Eigen::VectorXd& rounding_;  // per coordinate, Curve's floor of σ (0: none)
+  // The noise level's degrees of freedom where too few for kNoiseMargin to cover its scatter
+  // (kMarginDof), else 0: the residual test's degree raise then allows for it.
+  const double level_dof_;
 };
 
 // A window accepted while its residual is above the noise (lack-of-fit score above kSplitScore in
@@ -1105,7 +1124,9 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   curve.noisier_samples_ = profile.raised_samples();
   if (profile.varies()) curve.noise_sigma_max_ = profile.maximum();
   if (profile.stamp_noise()) curve.stamp_noise_s_ = std::sqrt(profile.stamp_noise()->variance);
-  const WindowFitter fitter(t, z, profile, options, curve.rounding_);
+  // An estimated level's own scatter, where kNoiseMargin does not cover it (a short recording).
+  const double level_dof = options.noise_sigma ? 0.0 : static_cast<double>(fitted_count) / kSamplesPerNoiseDof;
+  const WindowFitter fitter(t, z, profile, options, curve.rounding_, level_dof < kMarginDof ? level_dof : 0.0);
 
   // Segment boundaries [starts[k], starts[k+1]), with whether each segment ends at a jump; a
   // segment with one distinct stamp joins the neighbour across the shorter gap.
