@@ -6,7 +6,7 @@ usage: /usr/bin/python3 bench/velocity_sweep.py [--cheval build/cheval] [--data 
 
 Cases: smooth random motion (a few random tones, or a broad random spectrum) whose bandwidth runs from
 well resolved to a quarter of the sample rate, at 20/50/100/200 Hz, noise 0, 1 um, 50 um, 0.5 mm and
-2 mm; uneven stamps (jitter), stamps off by white errors, gaps, velocity steps (impacts); EuRoC ground truth at its own rate and
+2 mm; uneven stamps (jitter), stamps off by white errors, gaps, 20 dropouts of 0.3 s, velocity steps (impacts); EuRoC ground truth at its own rate and
 subsampled (every 2nd/5th/10th row), against its own velocity column. Baselines, computed here:
 central differences, the running median of five central differences, and Savitzky-Golay (local cubic
 on the stamps) with the best odd window 5..201 chosen with the truth (an oracle). Flags, per issue 14:
@@ -172,6 +172,15 @@ def special_cases():
         keep = ~(((t > 5.0) & (t < 5.5)) | ((t > 12.0) & (t < 14.0)))
         p, v = evaluate(axes, t[keep])
         yield (f"gaps 100Hz {sigma * 1e3:g}mm", t[keep], p + sigma * noise[keep], v, p)
+        # Dropouts: 20 gaps of 0.3 s at random places (a motion-capture marker lost again and
+        # again), on this motion and on a smooth one (f_max = 0.5 Hz, like a car) whose best Savitzky-Golay
+        # windows reach across the gaps.
+        t = np.arange(n) / rate
+        starts = np.random.default_rng(12).uniform(0.5, duration - 0.8, 20)
+        keep = ~np.any((t[:, None] >= starts[None, :]) & (t[:, None] < starts[None, :] + 0.3), axis=1)
+        for band, band_axes in (("mid", axes), ("smooth", tones(np.random.default_rng(13), 0.5, 6))):
+            p, v = evaluate(band_axes, t[keep])
+            yield (f"dropouts {band} 100Hz {sigma * 1e3:g}mm", t[keep], p + sigma * noise[keep], v, p)
         # Velocity steps (impacts) between samples every 0.37 s.
         t = np.arange(n) / rate
         p, v = evaluate(axes, t)
