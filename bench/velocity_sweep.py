@@ -173,8 +173,8 @@ def special_cases():
         p, v = evaluate(axes, t[keep])
         yield (f"gaps 100Hz {sigma * 1e3:g}mm", t[keep], p + sigma * noise[keep], v, p)
         # Dropouts: 20 gaps of 0.3 s at random places (a motion-capture marker lost again and
-        # again), on this motion and on a smooth one (f_max = 0.5 Hz, like a car) whose best Savitzky-Golay
-        # windows reach across the gaps.
+        # again), on this motion and on a smooth one (f_max = 0.5 Hz, like a car) whose best
+        # Savitzky-Golay windows reach across the gaps.
         t = np.arange(n) / rate
         starts = np.random.default_rng(12).uniform(0.5, duration - 0.8, 20)
         keep = ~np.any((t[:, None] >= starts[None, :]) & (t[:, None] < starts[None, :] + 0.3), axis=1)

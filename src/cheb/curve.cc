@@ -355,8 +355,9 @@ class WindowFitter {
 
   // Values rounded to a lattice (Curve::resolution) whose differences read less noise than the
   // rounding's q/sqrt(12) (a staircase, or a median of whole-step differences read low) may have
-  // errors correlated over many samples, and cross-validation follows them. A coordinate tested against that rounding level whose residual
-  // lies clearly below it takes the highest lower degree of the grid whose residual does not.
+  // errors correlated over many samples, and cross-validation follows them. A coordinate tested
+  // against that rounding level whose residual lies clearly below it takes the highest lower
+  // degree of the grid whose residual does not.
   void LowerBelowRounding(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
                           const Eigen::VectorXd& sigma, const NestedCholesky& cholesky, const NormalEquations& probe,
                           CurveWindow* window) const {

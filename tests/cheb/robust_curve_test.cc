@@ -3,7 +3,6 @@
 // existed: the tremor was smoothed away, a jump spread over its window, a glitch bent it, and the
 // even-spacing noise estimate took stamp jitter for noise.
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -18,6 +17,7 @@
 
 #include "cheval/cheb/curve.h"
 #include "cheval/cheb/degree.h"
+#include "synthetic_motion.h"
 
 namespace cheval::cheb {
 namespace {
@@ -140,22 +140,9 @@ TEST(ResidualTest, AShortNoisyRecordingIsNotFittedToItsNoise) {
     double sum = 0.0, central = 0.0;
     for (uint64_t seed = 1; seed <= kDraws; ++seed) {
       std::mt19937_64 rng(seed);
-      std::uniform_real_distribution<double> unit(0.0, 1.0);
-      std::vector<std::array<double, 4>> tones;  // axis, ω (rad/s), amplitude (m), phase
-      for (int c = 0; c < 3; ++c) {
-        for (int k = 0; k < 6; ++k) {
-          const double hz = k == 0 ? 2.0 : 0.05 * std::pow(40.0, unit(rng)), w = 2.0 * M_PI * hz;
-          const double amplitude = 0.3 / std::sqrt(6.0) * (0.5 + unit(rng)) / w;
-          tones.push_back({static_cast<double>(c), w, amplitude, 2.0 * M_PI * unit(rng)});
-        }
-      }
+      const std::vector<testing_motion::Tone> tones = testing_motion::SweepTones(2.0, &rng);
       const auto motion = [&](double t, Eigen::Vector3d* p, Eigen::Vector3d* v) {
-        p->setZero();
-        v->setZero();
-        for (const auto& [axis, w, amplitude, phase] : tones) {
-          (*p)[static_cast<int>(axis)] += amplitude * std::sin(w * t + phase);
-          (*v)[static_cast<int>(axis)] += amplitude * w * std::cos(w * t + phase);
-        }
+        testing_motion::EvaluateTones(tones, t, p, v);
       };
       const Motion s = Sample(motion, samples / 100.0, 100.0, 2e-3, 0.0, seed);
       sum += std::pow(VelocityRmse(FitCurve(s.stamps, s.positions), s), 2);

@@ -1,6 +1,7 @@
 #pragma once
 // Synthetic motion for the velocity fit's tests: sums of sinusoids per axis, sampled evenly, with
-// their exact velocity (tests/cheb/under_resolved_test.cc, local_regression_test.cc).
+// their exact velocity (tests/cheb/under_resolved_test.cc, local_regression_test.cc,
+// robust_curve_test.cc).
 
 #include <cmath>
 #include <cstdint>
@@ -21,21 +22,45 @@ struct Tone {
   double hz, amplitude, phase;  // position amplitude (m)
 };
 
+// Per axis six tones of log-uniform frequency from 0.05 Hz up to f_max (one at it), ~0.3 m/s in
+// all: bench/velocity_sweep.py's "tones" motion, drawn from `rng`.
+inline std::vector<Tone> SweepTones(double f_max, std::mt19937_64* rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Tone> tones;
+  for (int c = 0; c < 3; ++c) {
+    for (int k = 0; k < 6; ++k) {
+      const double hz = k == 0 ? f_max : std::exp(std::log(0.05) + (std::log(f_max) - std::log(0.05)) * unit(*rng));
+      const double rate = 0.3 / std::sqrt(6.0) * (0.5 + unit(*rng));
+      tones.push_back({c, hz, rate / (2.0 * M_PI * hz), 2.0 * M_PI * unit(*rng)});
+    }
+  }
+  return tones;
+}
+
+// The tones' position and velocity at time t (s).
+inline void EvaluateTones(const std::vector<Tone>& tones, double t, Eigen::Vector3d* p, Eigen::Vector3d* v) {
+  p->setZero();
+  v->setZero();
+  for (const Tone& tone : tones) {
+    const double w = 2.0 * M_PI * tone.hz;
+    (*p)[tone.axis] += tone.amplitude * std::sin(w * t + tone.phase);
+    (*v)[tone.axis] += tone.amplitude * w * std::cos(w * t + tone.phase);
+  }
+}
+
 // The tones sampled at `rate_hz` for 20 s, each sample's coordinates then drawn with noise σ.
 inline Tones Synthesize(double rate_hz, const std::vector<Tone>& tones, double noise, std::mt19937_64* rng) {
   std::normal_distribution<double> gauss(0.0, 1.0);
   const auto m = static_cast<Eigen::Index>(20.0 * rate_hz) + 1;
   Tones s;
-  s.positions = Eigen::MatrixXd::Zero(m, 3);
-  s.velocities = Eigen::MatrixXd::Zero(m, 3);
+  s.positions.resize(m, 3);
+  s.velocities.resize(m, 3);
   for (Eigen::Index i = 0; i < m; ++i) {
     s.stamps.push_back(std::llround(static_cast<double>(i) / rate_hz * 1e9));
-    const double t = static_cast<double>(i) / rate_hz;
-    for (const Tone& tone : tones) {
-      const double w = 2.0 * M_PI * tone.hz;
-      s.positions(i, tone.axis) += tone.amplitude * std::sin(w * t + tone.phase);
-      s.velocities(i, tone.axis) += tone.amplitude * w * std::cos(w * t + tone.phase);
-    }
+    Eigen::Vector3d p, v;
+    EvaluateTones(tones, static_cast<double>(i) / rate_hz, &p, &v);
+    s.positions.row(i) = p.transpose();
+    s.velocities.row(i) = v.transpose();
     if (noise > 0.0) {
       for (int c = 0; c < 3; ++c) s.positions(i, c) += noise * gauss(*rng);
     }

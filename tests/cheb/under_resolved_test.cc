@@ -16,6 +16,7 @@ namespace cheval::cheb {
 namespace {
 
 using testing_motion::Broad;
+using testing_motion::SweepTones;
 using testing_motion::Synthesize;
 using testing_motion::Tone;
 using testing_motion::Tones;
@@ -198,16 +199,7 @@ TEST(UnderResolved, NoisyBroadMotionNearAQuarterOfTheRateTakesALocalRate) {
 // in all (bench/velocity_sweep.py's "tones fast"), under noise σ.
 Tones FastTones(double rate_hz, double noise, uint64_t seed) {
   std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::vector<Tone> tones;
-  const double top = rate_hz / 4.0;
-  for (int c = 0; c < 3; ++c) {
-    for (int k = 0; k < 6; ++k) {
-      const double hz = k == 0 ? top : std::exp(std::log(0.05) + (std::log(top) - std::log(0.05)) * unit(rng));
-      const double rate = 0.3 / std::sqrt(6.0) * (0.5 + unit(rng));
-      tones.push_back({c, hz, rate / (2.0 * M_PI * hz), 2.0 * M_PI * unit(rng)});
-    }
-  }
+  const std::vector<Tone> tones = SweepTones(rate_hz / 4.0, &rng);
   return Synthesize(rate_hz, tones, noise, &rng);
 }
 
