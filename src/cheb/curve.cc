@@ -6,6 +6,7 @@
 #include "local_rates.h"
 #include "local_regression.h"
 #include "noise_profile.h"
+#include "residual_test.h"
 #include "work_queue.h"
 
 #include <algorithm>
@@ -29,16 +30,6 @@ namespace {
 // The relative tolerance below which coefficients are rounding, not signal: the chop's floor when
 // the data are noise-free.
 constexpr double kRoundingTolerance = 1e-13;
-// A window's residual is consistent with the noise while its lack-of-fit score (a standard normal
-// score of χ²) stays below this: a false alarm per coordinate and window has probability 0.13 %
-// (a split that costs little), while at 4 small unresolved motion (a tremor of twice the noise)
-// passes in short windows (docs/decisions.md).
-constexpr double kLackOfFitLimit = 3.0;
-// The residual is tested against the noise σ times this: σ is an estimate and the noise of real
-// data (and of rotation charts, J_r⁻¹ stretched) varies by some per cent, which in a window of
-// hundreds of samples a χ² test alone would take for unresolved motion (it made the drone's body
-// rate 2–3x worse); a residual of 1.5σ (a missed tremor) still fails.
-constexpr double kNoiseMargin = 1.1;
 // The noise level is a median over the recording's differences, and scatters like a variance
 // estimate with about one degree of freedom per kSamplesPerNoiseDof samples (measured on white
 // noise: 0.16–0.22 per sample from 100 to 1,000 samples). Where that is fewer than kMarginDof, the
@@ -66,7 +57,10 @@ constexpr Eigen::Index kParallelSamples = 2000;
 constexpr Eigen::Index kParallelQueries = 8192;
 // End windows are halved (RefineEnds) while they keep this many samples on each side.
 constexpr Eigen::Index kMinEndWindowSamples = 24;
+using internal::kLackOfFitLimit;
 using internal::kMaxGramCondition;
+using internal::kNoiseMargin;
+using internal::LackOfFitScore;
 
 // Fits one window and, for automatic degrees, says whether it should be split instead.
 class WindowFitter {
@@ -315,21 +309,6 @@ class WindowFitter {
       sigma[c] = std::max(level[c], 1e-9 * (1.0 + z.col(c).cwiseAbs().maxCoeff()));
     }
     return sigma;
-  }
-
-  // Standard normal score of RSS/σ² against χ² with `dof` degrees of freedom (Wilson–Hilferty:
-  // (X/ν)^(1/3) is nearly normal with mean 1 − 2/(9ν) and variance 2/(9ν)); 0 without freedom.
-  // With `sigma_dof` > 0, σ² is itself an estimate with that many degrees of freedom, and the
-  // score is that of RSS/(νσ²) against F(ν, sigma_dof) (Paulson's approximation, which reduces to
-  // Wilson–Hilferty as sigma_dof grows: Abramowitz & Stegun 26.6.15).
-  static double LackOfFitScore(double rss, double sigma, Eigen::Index dof, double sigma_dof = 0.0) {
-    if (dof <= 0) return 0.0;
-    sigma *= kNoiseMargin;
-    const double nu = static_cast<double>(dof), v = 2.0 / (9.0 * nu);
-    const double root = std::cbrt(rss / (sigma * sigma) / nu);
-    if (sigma_dof <= 0.0) return (root - (1.0 - v)) / std::sqrt(v);
-    const double w = 2.0 / (9.0 * sigma_dof);
-    return ((1.0 - w) * root - (1.0 - v)) / std::sqrt(w * root * root + v);
   }
 
   // Residuals of a window's series at its samples: fills residual_rms and lack_of_fit; whether

@@ -1,0 +1,37 @@
+#pragma once
+// Internal to the cheb library: the residual test of a fitted window (curve.cc) and of a fit across
+// a gap (bridges.cc), docs/velocity.md "Residual test".
+
+#include <cmath>
+
+#include <Eigen/Core>
+
+namespace cheval::cheb::internal {
+
+// A window's residual is consistent with the noise while its lack-of-fit score (a standard normal
+// score of χ²) stays below this: a false alarm per coordinate and window has probability 0.13 %
+// (a split that costs little), while at 4 small unresolved motion (a tremor of twice the noise)
+// passes in short windows (docs/decisions.md).
+inline constexpr double kLackOfFitLimit = 3.0;
+// The residual is tested against the noise σ times this: σ is an estimate and the noise of real
+// data (and of rotation charts, J_r⁻¹ stretched) varies by some per cent, which in a window of
+// hundreds of samples a χ² test alone would take for unresolved motion (it made the drone's body
+// rate 2–3x worse); a residual of 1.5σ (a missed tremor) still fails.
+inline constexpr double kNoiseMargin = 1.1;
+
+// Standard normal score of RSS/σ² against χ² with `dof` degrees of freedom (Wilson–Hilferty:
+// (X/ν)^(1/3) is nearly normal with mean 1 − 2/(9ν) and variance 2/(9ν)); 0 without freedom.
+// With `sigma_dof` > 0, σ² is itself an estimate with that many degrees of freedom, and the
+// score is that of RSS/(νσ²) against F(ν, sigma_dof) (Paulson's approximation, which reduces to
+// Wilson–Hilferty as sigma_dof grows: Abramowitz & Stegun 26.6.15).
+inline double LackOfFitScore(double rss, double sigma, Eigen::Index dof, double sigma_dof = 0.0) {
+  if (dof <= 0) return 0.0;
+  sigma *= kNoiseMargin;
+  const double nu = static_cast<double>(dof), v = 2.0 / (9.0 * nu);
+  const double root = std::cbrt(rss / (sigma * sigma) / nu);
+  if (sigma_dof <= 0.0) return (root - (1.0 - v)) / std::sqrt(v);
+  const double w = 2.0 / (9.0 * sigma_dof);
+  return ((1.0 - w) * root - (1.0 - v)) / std::sqrt(w * root * root + v);
+}
+
+}  // namespace cheval::cheb::internal
