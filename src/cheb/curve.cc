@@ -1,5 +1,6 @@
 #include "cheval/cheb/curve.h"
 
+#include "bridges.h"
 #include "conditioning.h"
 #include "end_caps.h"
 #include "jumps.h"
@@ -1207,6 +1208,8 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
       const bool front_at_jump = k > 0 && curve.segments_[k - 1].continues;
       internal::AddEndCaps(t, z, velocity, starts[k], starts[k + 1], front_at_jump, &curve.segments_[k], threads);
     }
+    // Then fits across the gaps take over the segments' ends where they are the better estimate.
+    internal::BridgeGaps(t, z, starts, profile, curve.rounding_, &curve.segments_, threads);
   }
 
   // Where windows clearly missed motion, the samples' own local interpolant (docs/velocity.md).
@@ -1592,6 +1595,7 @@ std::string_view ToString(WindowVerdict verdict) {
     case WindowVerdict::kResolved: return "resolved";
     case WindowVerdict::kUnresolved: return "unresolved";
     case WindowVerdict::kFixedDegree: return "fixed_degree";
+    case WindowVerdict::kBridge: return "bridge";
   }
   return "unknown";
 }

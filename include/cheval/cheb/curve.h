@@ -70,8 +70,10 @@ struct CurveOptions {
   /// velocity error: the cap's length, blending boundary and degrees are chosen by one-sided fits
   /// at artificial ends inside the segment, checked against the curve's interior velocity there
   /// (docs/velocity.md, "End caps"). Adaptive windows only (not with window_s, single_window or a
-  /// fixed degree, which ask for a literal fit); segments need at least three windows. false keeps
-  /// the end windows' own polynomials.
+  /// fixed degree, which ask for a literal fit); segments need at least three windows. At a gap, a
+  /// fit across it takes over a segment's end where the data on both sides say it is the better
+  /// estimate (docs/velocity.md, "Gaps"; WindowVerdict::kBridge). false keeps the end windows' own
+  /// polynomials.
   bool end_caps = true;
   /// Fit a single window over each gap-free segment (no splitting), e.g. to reproduce a global fit.
   bool single_window = false;
@@ -125,9 +127,13 @@ enum class WindowVerdict {
   kUnresolved,
   /// A fixed degree was asked for: nothing was tested for acceptance.
   kFixedDegree,
+  /// A fit across a gap that stands in for a segment's end (docs/velocity.md, "Gaps"): its
+  /// residual over the samples on both sides is consistent with the noise, and where it takes over
+  /// its rate has the smaller variance and its residuals no trend.
+  kBridge,
 };
 
-/// "resolved", "unresolved" or "fixed_degree" (the JSON and the report name verdicts so).
+/// "resolved", "unresolved", "fixed_degree" or "bridge" (the JSON and the report name verdicts so).
 std::string_view ToString(WindowVerdict verdict);
 
 /// One window: its core [core_begin, core_end] (seconds from the curve's origin), the samples used

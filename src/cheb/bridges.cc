@@ -1,0 +1,353 @@
+#include "bridges.h"
+#include "residual_test.h"
+#include "work_queue.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <optional>
+
+#include "cheval/cheb/chebyshev.h"
+#include "cheval/cheb/fit.h"
+#include "cheval/common/error.h"
+
+namespace cheval::cheb::internal {
+namespace {
+
+// The samples within this many gap lengths on either side of a gap are fitted across it: of the
+// reaches whose fits pass the residual test, the one whose rates beside the gap have the least
+// variance (the longest the motion allows, for it is smooth enough there).
+constexpr std::array<double, 3> kReaches{2.0, 4.0, 8.0};
+// Each side of a gap keeps at least this many samples within reach to be fitted across it.
+constexpr Eigen::Index kMinSide = 4;
+// The slope of a fit's residuals where it takes over may reach this many of its standard deviations
+// (as the residual test's limit, kLackOfFitLimit).
+constexpr double kTrendLimit = 3.0;
+// N²/m of a fit across a gap at most, as the windows' (CurveOptions::max_conditioning's default).
+constexpr double kMaxConditioning = 8.0;
+
+// d/dt of T_0..T_top at t on `interval`: k U_{k-1}(x) · dx/dt (U of the second kind).
+Eigen::VectorXd DerivativeBasis(const Interval& interval, double t, int top) {
+  const double x = interval.ToUnit(t), scale = interval.DerivativeScale();
+  Eigen::VectorXd basis(top + 1);
+  basis[0] = 0.0;
+  double u_previous = 0.0, u = 1.0;  // U_{k-2}, U_{k-1}
+  for (int k = 1; k <= top; ++k) {
+    basis[k] = k * u * scale;
+    const double next = 2.0 * x * u - u_previous;
+    u_previous = u;
+    u = next;
+  }
+  return basis;
+}
+
+// A least-squares fit of samples [first, first + count) with a degree per coordinate, and the
+// variance factor dᵀG⁻¹d of its rate at one time per coordinate (d the derivative's basis there:
+// times σ², the rate's variance).
+struct SideFit {
+  Interval interval;
+  Eigen::MatrixXd coefficients;  // (top + 1) x d, zero above each coordinate's degree
+  Eigen::VectorXd rate_variance_factor;
+};
+
+SideFit FitAt(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index count,
+              const Interval& interval, const std::vector<int>& degrees, double at) {
+  const Eigen::Index d = z.cols();
+  const int top = *std::max_element(degrees.begin(), degrees.end());
+  const NormalEquations normal = BuildNormalEquations(t.segment(first, count), z.middleRows(first, count), top, interval);
+  const NestedCholesky cholesky(normal, top);
+  const Eigen::VectorXd basis = DerivativeBasis(interval, at, top);
+  const Eigen::MatrixXd whitened = cholesky.Whiten(top, basis);
+  SideFit fit{interval, Eigen::MatrixXd::Zero(top + 1, d), Eigen::VectorXd(d)};
+  for (Eigen::Index c = 0; c < d; ++c) {
+    const int n = degrees[static_cast<size_t>(c)];
+    fit.coefficients.col(c).head(n + 1) = cholesky.Solve(n, normal.rhs.col(c));
+    fit.rate_variance_factor[c] = whitened.col(0).head(n + 1).squaredNorm();
+  }
+  return fit;
+}
+
+// The fit across a gap: samples [first, first + count) of both sides, the degree per coordinate
+// chosen by generalised cross-validation (m·RSS/(m − N − 1)², Craven & Wahba 1979) up to `top`,
+// and whether its residual passes the residual test against σ (per coordinate).
+struct Bridge {
+  std::vector<int> degrees;
+  Eigen::VectorXd residual_rms, lack_of_fit;
+  bool passes = true;
+};
+
+Bridge FitBridge(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index count,
+                 const Interval& interval, int top, const Eigen::VectorXd& sigma) {
+  const Eigen::Index d = z.cols();
+  const auto tw = t.segment(first, count);
+  const auto zw = z.middleRows(first, count);
+  const NormalEquations normal = BuildNormalEquations(tw, zw, top, interval);
+  const NestedCholesky cholesky(normal, top);
+  Eigen::VectorXd x(count);
+  for (Eigen::Index i = 0; i < count; ++i) x[i] = interval.ToUnit(tw[i]);
+  Bridge bridge{std::vector<int>(static_cast<size_t>(d), 1), Eigen::VectorXd(d), Eigen::VectorXd(d)};
+  Eigen::VectorXd best = Eigen::VectorXd::Constant(d, std::numeric_limits<double>::infinity()), rss(d);
+  for (int n = 1; n <= top; ++n) {
+    // Residuals on the samples themselves: the sums of the normal equations lose nearly exact data's.
+    const Eigen::VectorXd squares =
+        (zw - EvaluateSeries(cholesky.Solve(n, normal.rhs), x)).colwise().squaredNorm().transpose();
+    const double free = static_cast<double>(count - n - 1);
+    for (Eigen::Index c = 0; c < d; ++c) {
+      const double score = static_cast<double>(count) * squares[c] / (free * free);
+      if (score < best[c]) best[c] = score, bridge.degrees[static_cast<size_t>(c)] = n, rss[c] = squares[c];
+    }
+  }
+  for (Eigen::Index c = 0; c < d; ++c) {
+    const int n = bridge.degrees[static_cast<size_t>(c)];
+    bridge.residual_rms[c] = std::sqrt(rss[c] / static_cast<double>(count));
+    bridge.lack_of_fit[c] = LackOfFitScore(rss[c], sigma[c], count - n - 1);
+    bridge.passes = bridge.passes && bridge.lack_of_fit[c] <= kLackOfFitLimit;
+  }
+  return bridge;
+}
+
+// The window of a side: the bridge's polynomial re-expanded exactly on that side's samples
+// [first, first + count) (inside the bridge's interval: no extrapolation).
+CurveWindow SideWindow(const Eigen::VectorXd& t, const SideFit& fit, const Bridge& bridge, Eigen::Index first,
+                       Eigen::Index count, const Eigen::VectorXd& sigma) {
+  const Eigen::Index d = fit.coefficients.cols();
+  CurveWindow window;
+  window.fit_begin = t[first];
+  window.fit_end = t[first + count - 1];
+  window.samples = count;
+  window.degrees = bridge.degrees;
+  window.series.interval = {window.fit_begin, window.fit_end};
+  const int top = *std::max_element(bridge.degrees.begin(), bridge.degrees.end());
+  window.series.coefficients = Eigen::MatrixXd::Zero(top + 1, d);
+  for (Eigen::Index c = 0; c < d; ++c) {
+    const int n = bridge.degrees[static_cast<size_t>(c)];
+    const Eigen::VectorXd points = ChebyshevPoints(n, window.series.interval);
+    Eigen::MatrixXd values(n + 1, 1);
+    for (int k = 0; k <= n; ++k) {
+      values(k, 0) = Clenshaw(fit.coefficients.col(c).head(n + 1), fit.interval.ToUnit(points[k]))[0];
+    }
+    window.series.coefficients.col(c).head(n + 1) = ValuesToCoefficients(values);
+  }
+  window.coefficient_magnitudes = window.series.coefficients.cwiseAbs();
+  window.first_derivative = DerivativeCoefficients(window.series.coefficients);
+  window.second_derivative = DerivativeCoefficients(window.first_derivative);
+  window.residual_rms = bridge.residual_rms;
+  window.lack_of_fit = bridge.lack_of_fit;
+  window.noise_sigma = sigma;
+  window.verdict = WindowVerdict::kBridge;
+  return window;
+}
+
+// The rate's variance factor of a segment's end window at time `at`, fitted again to its samples
+// [first, first + count) (the segment's samples inside its fit interval).
+std::optional<Eigen::VectorXd> EndVarianceFactor(const Eigen::VectorXd& t, const Eigen::MatrixXd& z,
+                                                 Eigen::Index first, Eigen::Index count, const CurveWindow& window,
+                                                 double at) {
+  try {
+    return FitAt(t, z, first, count, window.series.interval, window.degrees, at).rate_variance_factor;
+  } catch (const ComputeError&) {
+    return std::nullopt;  // repeated stamps: the end window's samples do not determine it again
+  }
+}
+
+// A gap's fit and its two sides: the back of the segment before (side 0) and the front of the
+// one after (side 1).
+struct GapFit {
+  Bridge bridge;
+  Eigen::Index first = 0, count = 0, gap = 0;  // the fit's samples; the first sample after the gap
+  Eigen::VectorXd sigma;
+  std::array<SideFit, 2> sides;
+};
+
+// Fits across the gap before sample `gap`, between segments [before, gap) and [gap, after), the
+// samples within `reach` of it.
+std::optional<GapFit> FitGap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index before, Eigen::Index gap,
+                             Eigen::Index after, double reach, const NoiseProfile& noise,
+                             const Eigen::VectorXd& rounding) {
+  const double* data = t.data();
+  const double length = t[gap] - t[gap - 1];
+  GapFit fit;
+  fit.gap = gap;
+  fit.first = std::lower_bound(data + before, data + gap, t[gap - 1] - reach) - data;
+  const Eigen::Index last = std::upper_bound(data + gap, data + after, t[gap] + reach) - data;
+  fit.count = last - fit.first;
+  const Eigen::Index left = gap - fit.first, right = last - gap;
+  if (std::min(left, right) < kMinSide) return std::nullopt;
+  const Interval interval{t[fit.first], t[last - 1]};
+  // What the hole allows, the conditioning limit, and two samples a coefficient (a fit close to
+  // interpolating its few samples passes any residual test).
+  const int top = static_cast<int>(std::min<double>({std::floor(0.5 * std::numbers::pi * (interval.b - interval.a) / length),
+                                                     std::floor(std::sqrt(kMaxConditioning * static_cast<double>(fit.count))),
+                                                     static_cast<double>(fit.count / 2 - 1)}));
+  if (top < 1) return std::nullopt;
+  fit.sigma = noise.Over(fit.first, fit.count);
+  for (Eigen::Index c = 0; c < z.cols(); ++c) {
+    fit.sigma[c] = std::max({fit.sigma[c], rounding[c],
+                             1e-9 * (1.0 + z.col(c).segment(fit.first, fit.count).cwiseAbs().maxCoeff())});
+  }
+  try {
+    fit.bridge = FitBridge(t, z, fit.first, fit.count, interval, top, fit.sigma);
+    if (!fit.bridge.passes) return std::nullopt;
+    fit.sides[0] = FitAt(t, z, fit.first, fit.count, interval, fit.bridge.degrees, t[gap - 1]);
+    fit.sides[1] = FitAt(t, z, fit.first, fit.count, interval, fit.bridge.degrees, t[gap]);
+  } catch (const ComputeError&) {
+    return std::nullopt;  // repeated stamps: the samples do not determine the fit
+  }
+  return fit;
+}
+
+// Whether the residuals of a side's fit over samples [first, first + count) (those where it takes
+// over) show no trend: the slope of their least-squares line is its rate's bias averaged there,
+// and it must stay within kTrendLimit standard deviations (σ/sqrt(Σ(t − t̄)²)) in every coordinate.
+// Under noise the slope is the noise's; on nearly noise-free data it is the bias of a fit held to
+// a hole's low degree, which the segment's own end (then exact) does not have.
+bool ResidualTrendIsNoise(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index count,
+                          const SideFit& fit, const Eigen::VectorXd& sigma) {
+  const auto tw = t.segment(first, count);
+  Eigen::VectorXd x(count);
+  for (Eigen::Index i = 0; i < count; ++i) x[i] = fit.interval.ToUnit(tw[i]);
+  const Eigen::MatrixXd residual = z.middleRows(first, count) - EvaluateSeries(fit.coefficients, x);
+  const Eigen::VectorXd centred = tw.array() - tw.mean();
+  const double spread = centred.squaredNorm();
+  if (!(spread > 0.0)) return false;
+  for (Eigen::Index c = 0; c < z.cols(); ++c) {
+    const double slope = centred.dot(residual.col(c)) / spread;
+    if (!(std::abs(slope) <= kTrendLimit * sigma[c] / std::sqrt(spread))) return false;
+  }
+  return true;
+}
+
+// The rate's variance factor of the segment [begin, end)'s own fit at its sample `at`: that of the
+// window at that end, fitted again to its samples.
+std::optional<Eigen::VectorXd> OwnVarianceFactor(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index begin,
+                                                 Eigen::Index end, const CurveSegment& segment, Eigen::Index at) {
+  const double* data = t.data();
+  const CurveWindow& own = at + 1 == end ? segment.windows.back() : segment.windows.front();
+  const Eigen::Index own_first = std::lower_bound(data + begin, data + end, own.fit_begin) - data;
+  const Eigen::Index own_count = std::upper_bound(data + begin, data + end, own.fit_end) - data - own_first;
+  return EndVarianceFactor(t, z, own_first, own_count, own, t[at]);
+}
+
+// Whether a gap's side may stand in for the segment [begin, end) it borders (`back`: at the
+// segment's back) over its samples [from, from + count): its rate has the smaller variance than
+// the segment's own at the sample beside the gap (and, for a whole segment, at its other end too),
+// and its residuals there show no trend.
+bool SideHelps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const GapFit& gap, bool back, Eigen::Index begin,
+               Eigen::Index end, const CurveSegment& segment, Eigen::Index from, Eigen::Index count,
+               const GapFit* incumbent = nullptr) {
+  const SideFit& fit = gap.sides[back ? 0 : 1];
+  const Eigen::VectorXd variance = gap.sigma.cwiseAbs2();
+  const bool whole = from == begin && count == end - begin;
+  for (const Eigen::Index at : {back ? end - 1 : begin, back ? begin : end - 1}) {
+    // An end window its samples do not determine again (fewer distinct stamps than its degree
+    // asks for: a few samples between dropouts) is no rival.
+    const std::optional<Eigen::VectorXd> own =
+        incumbent != nullptr ? FitAt(t, z, incumbent->first, incumbent->count, incumbent->sides[0].interval,
+                                     incumbent->bridge.degrees, t[at])
+                                   .rate_variance_factor
+                             : OwnVarianceFactor(t, z, begin, end, segment, at);
+    const Eigen::VectorXd factor =
+        at == (back ? end - 1 : begin)
+            ? fit.rate_variance_factor
+            : FitAt(t, z, gap.first, gap.count, fit.interval, gap.bridge.degrees, t[at]).rate_variance_factor;
+    if (own && !(factor.dot(variance) < own->dot(variance))) return false;
+    if (!whole) break;
+  }
+  return ResidualTrendIsNoise(t, z, from, count, fit, gap.sigma);
+}
+
+// The window of a gap's side over the segment samples [from, from + count) it covers.
+CurveWindow SideWindow(const Eigen::VectorXd& t, const GapFit& gap, bool back) {
+  const Eigen::Index from = back ? gap.first : gap.gap;
+  const Eigen::Index count = back ? gap.gap - gap.first : gap.first + gap.count - gap.gap;
+  return SideWindow(t, gap.sides[back ? 0 : 1], gap.bridge, from, count, gap.sigma);
+}
+
+// Puts `bridge` at the back (or front) of a segment, from `boundary` on (up to it): windows whose
+// core lies past the boundary go, the one holding it is cut there.
+void Insert(CurveWindow bridge, double boundary, bool back, CurveSegment* segment) {
+  std::vector<CurveWindow>& windows = segment->windows;
+  if (back) {
+    bridge.core_begin = boundary;
+    bridge.core_end = windows.back().core_end;
+    while (windows.size() > 1 && windows.back().core_begin >= boundary) windows.pop_back();
+    windows.back().core_end = boundary;
+    windows.push_back(std::move(bridge));
+  } else {
+    bridge.core_begin = windows.front().core_begin;
+    bridge.core_end = boundary;
+    while (windows.size() > 1 && windows.front().core_end <= boundary) windows.erase(windows.begin());
+    windows.front().core_begin = boundary;
+    windows.insert(windows.begin(), std::move(bridge));
+  }
+}
+
+}  // namespace
+
+void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<Eigen::Index>& starts,
+                const NoiseProfile& noise, const Eigen::VectorXd& rounding, std::vector<CurveSegment>* segments,
+                int threads) {
+  const size_t count = segments->size();
+  // fits[k]: across the gap after segment k.
+  std::vector<std::optional<GapFit>> fits(count);
+  ParallelFor(static_cast<int>(count) - 1, threads, [&](int gap_index) {
+    const auto k = static_cast<size_t>(gap_index);
+    if ((*segments)[k].continues) return;  // a jump, not a gap
+    const Eigen::Index gap = starts[k + 1];
+    double least = std::numeric_limits<double>::infinity();
+    for (const double reach : kReaches) {
+      std::optional<GapFit> fit =
+          FitGap(t, z, starts[k], gap, starts[k + 2], reach * (t[gap] - t[gap - 1]), noise, rounding);
+      if (!fit) continue;
+      const Eigen::VectorXd variance = fit->sigma.cwiseAbs2();
+      const double spread =
+          variance.dot(fit->sides[0].rate_variance_factor) + variance.dot(fit->sides[1].rate_variance_factor);
+      const bool same = fits[k] && fits[k]->first == fit->first && fits[k]->count == fit->count;
+      if (spread < least && !same) least = spread, fits[k] = std::move(fit);
+    }
+  });
+  for (size_t k = 0; k < count; ++k) {
+    CurveSegment& segment = (*segments)[k];
+    const Eigen::Index begin = starts[k], end = starts[k + 1], n = end - begin;
+    const GapFit* front = k > 0 && fits[k - 1] ? &*fits[k - 1] : nullptr;
+    const GapFit* back = fits[k] ? &*fits[k] : nullptr;
+    // A segment the fits of its gaps cover whole (one or both ends at a gap; a short segment
+    // between dropouts): those of them that help over all of it replace its windows, two blended
+    // across its middle.
+    const bool front_covers = front != nullptr && front->first + front->count == end;
+    const bool back_covers = back != nullptr && back->first == begin;
+    const bool front_whole = front_covers && SideHelps(t, z, *front, false, begin, end, segment, begin, n);
+    const bool back_whole = back_covers && SideHelps(t, z, *back, true, begin, end, segment, begin, n);
+    if (front_whole || back_whole) {
+      std::vector<CurveWindow> windows;
+      if (front_whole) windows.push_back(SideWindow(t, *front, false));
+      if (back_whole) windows.push_back(SideWindow(t, *back, true));
+      windows.front().core_begin = segment.windows.front().core_begin;
+      windows.back().core_end = segment.windows.back().core_end;
+      if (windows.size() == 2) windows[0].core_end = windows[1].core_begin = t[begin + (n - 1) / 2];
+      segment.windows = std::move(windows);
+    }
+    // Otherwise each end's own: alone over z/2 samples from the gap, blended up to 1.5z, z a third
+    // of its side's samples and of the segment's (room for both ends' blends). Not a fit whose
+    // residuals over a segment it covers show a trend: it is biased somewhere there.
+    const GapFit* whole = front_whole ? front : back_whole ? back : nullptr;
+    for (const bool at_back : {true, false}) {
+      const GapFit* gap = at_back ? back : front;
+      if (gap == nullptr || gap == whole) continue;
+      if ((at_back ? back_covers : front_covers) &&
+          !ResidualTrendIsNoise(t, z, begin, n, gap->sides[at_back ? 0 : 1], gap->sigma)) {
+        continue;
+      }
+      const Eigen::Index side = at_back ? gap->gap - gap->first : gap->first + gap->count - gap->gap;
+      const Eigen::Index zone = std::min(side - 1, n - 1) / 3;
+      if (zone < 1) continue;
+      const Eigen::Index reached = std::min<Eigen::Index>(side, static_cast<Eigen::Index>(std::ceil(1.5 * zone)) + 1);
+      if (!SideHelps(t, z, *gap, at_back, begin, end, segment, at_back ? end - reached : begin, reached, whole)) continue;
+      Insert(SideWindow(t, *gap, at_back), at_back ? t[end - 1 - zone] : t[begin + zone], at_back, &segment);
+    }
+  }
+}
+
+}  // namespace cheval::cheb::internal
