@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <utility>
 
 #include "cheval/cheb/chebyshev.h"
 #include "cheval/cheb/fit.h"
@@ -108,7 +109,7 @@ Bridge FitBridge(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Inde
   return bridge;
 }
 
-// The window of a side: the bridge's polynomial re-expanded exactly on that side's samples
+// The window of a side: the bridge's polynomial re-expanded exactly on a segment's samples
 // [first, first + count) (inside the bridge's interval: no extrapolation).
 CurveWindow SideWindow(const Eigen::VectorXd& t, const SideFit& fit, const Bridge& bridge, Eigen::Index first,
                        Eigen::Index count, const Eigen::VectorXd& sigma) {
@@ -161,13 +162,12 @@ struct GapFit {
   std::array<SideFit, 2> sides;
 };
 
-// Fits across the gap before sample `gap`, between segments [before, gap) and [gap, after), the
-// samples within `reach` of it.
+// Fits across the gap before sample `gap` the samples within `reach` of it, across further gaps
+// too (between dropouts the segments are short) but inside [before, after) (not across a jump).
 std::optional<GapFit> FitGap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index before, Eigen::Index gap,
                              Eigen::Index after, double reach, const NoiseProfile& noise,
                              const Eigen::VectorXd& rounding) {
   const double* data = t.data();
-  const double length = t[gap] - t[gap - 1];
   GapFit fit;
   fit.gap = gap;
   fit.first = std::lower_bound(data + before, data + gap, t[gap - 1] - reach) - data;
@@ -176,6 +176,8 @@ std::optional<GapFit> FitGap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z,
   const Eigen::Index left = gap - fit.first, right = last - gap;
   if (std::min(left, right) < kMinSide) return std::nullopt;
   const Interval interval{t[fit.first], t[last - 1]};
+  double length = 0.0;  // the longest hole inside
+  for (Eigen::Index i = fit.first + 1; i < last; ++i) length = std::max(length, t[i] - t[i - 1]);
   // What the hole allows, the conditioning limit, and two samples a coefficient (a fit close to
   // interpolating its few samples passes any residual test).
   const int top = static_cast<int>(std::min<double>({std::floor(0.5 * std::numbers::pi * (interval.b - interval.a) / length),
@@ -258,10 +260,19 @@ bool SideHelps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const GapFit&
   return ResidualTrendIsNoise(t, z, from, count, fit, gap.sigma);
 }
 
-// The window of a gap's side over the segment samples [from, from + count) it covers.
-CurveWindow SideWindow(const Eigen::VectorXd& t, const GapFit& gap, bool back) {
-  const Eigen::Index from = back ? gap.first : gap.gap;
-  const Eigen::Index count = back ? gap.gap - gap.first : gap.first + gap.count - gap.gap;
+// The samples of the segment [begin, end) that a gap's fit covers on its side (`back`: the gap
+// follows the segment): [from, from + count).
+std::pair<Eigen::Index, Eigen::Index> SideSamples(const GapFit& gap, bool back, Eigen::Index begin, Eigen::Index end) {
+  if (back) {
+    const Eigen::Index from = std::max(gap.first, begin);
+    return {from, gap.gap - from};
+  }
+  return {gap.gap, std::min(gap.first + gap.count, end) - gap.gap};
+}
+
+// The window of a gap's side over the samples of the segment [begin, end) it covers.
+CurveWindow SideWindow(const Eigen::VectorXd& t, const GapFit& gap, bool back, Eigen::Index begin, Eigen::Index end) {
+  const auto [from, count] = SideSamples(gap, back, begin, end);
   return SideWindow(t, gap.sides[back ? 0 : 1], gap.bridge, from, count, gap.sigma);
 }
 
@@ -290,6 +301,11 @@ void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
                 const NoiseProfile& noise, const Eigen::VectorXd& rounding, std::vector<CurveSegment>* segments,
                 int threads) {
   const size_t count = segments->size();
+  // The first (and one past the last) segment of the run of segments joined by gaps, not jumps,
+  // that segment k lies in.
+  std::vector<size_t> run_begin(count), run_end(count);
+  for (size_t k = 0; k < count; ++k) run_begin[k] = k > 0 && !(*segments)[k - 1].continues ? run_begin[k - 1] : k;
+  for (size_t k = count; k-- > 0;) run_end[k] = k + 1 < count && !(*segments)[k].continues ? run_end[k + 1] : k + 1;
   // fits[k]: across the gap after segment k.
   std::vector<std::optional<GapFit>> fits(count);
   ParallelFor(static_cast<int>(count) - 1, threads, [&](int gap_index) {
@@ -298,8 +314,8 @@ void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
     const Eigen::Index gap = starts[k + 1];
     double least = std::numeric_limits<double>::infinity();
     for (const double reach : kReaches) {
-      std::optional<GapFit> fit =
-          FitGap(t, z, starts[k], gap, starts[k + 2], reach * (t[gap] - t[gap - 1]), noise, rounding);
+      std::optional<GapFit> fit = FitGap(t, z, starts[run_begin[k]], gap, starts[run_end[k + 1]],
+                                         reach * (t[gap] - t[gap - 1]), noise, rounding);
       if (!fit) continue;
       const Eigen::VectorXd variance = fit->sigma.cwiseAbs2();
       const double spread =
@@ -316,14 +332,14 @@ void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
     // A segment the fits of its gaps cover whole (one or both ends at a gap; a short segment
     // between dropouts): those of them that help over all of it replace its windows, two blended
     // across its middle.
-    const bool front_covers = front != nullptr && front->first + front->count == end;
-    const bool back_covers = back != nullptr && back->first == begin;
+    const bool front_covers = front != nullptr && front->first + front->count >= end;
+    const bool back_covers = back != nullptr && back->first <= begin;
     const bool front_whole = front_covers && SideHelps(t, z, *front, false, begin, end, segment, begin, n);
     const bool back_whole = back_covers && SideHelps(t, z, *back, true, begin, end, segment, begin, n);
     if (front_whole || back_whole) {
       std::vector<CurveWindow> windows;
-      if (front_whole) windows.push_back(SideWindow(t, *front, false));
-      if (back_whole) windows.push_back(SideWindow(t, *back, true));
+      if (front_whole) windows.push_back(SideWindow(t, *front, false, begin, end));
+      if (back_whole) windows.push_back(SideWindow(t, *back, true, begin, end));
       windows.front().core_begin = segment.windows.front().core_begin;
       windows.back().core_end = segment.windows.back().core_end;
       if (windows.size() == 2) windows[0].core_end = windows[1].core_begin = t[begin + (n - 1) / 2];
@@ -340,12 +356,12 @@ void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
           !ResidualTrendIsNoise(t, z, begin, n, gap->sides[at_back ? 0 : 1], gap->sigma)) {
         continue;
       }
-      const Eigen::Index side = at_back ? gap->gap - gap->first : gap->first + gap->count - gap->gap;
+      const Eigen::Index side = SideSamples(*gap, at_back, begin, end).second;
       const Eigen::Index zone = std::min(side - 1, n - 1) / 3;
       if (zone < 1) continue;
       const Eigen::Index reached = std::min<Eigen::Index>(side, static_cast<Eigen::Index>(std::ceil(1.5 * zone)) + 1);
       if (!SideHelps(t, z, *gap, at_back, begin, end, segment, at_back ? end - reached : begin, reached, whole)) continue;
-      Insert(SideWindow(t, *gap, at_back), at_back ? t[end - 1 - zone] : t[begin + zone], at_back, &segment);
+      Insert(SideWindow(t, *gap, at_back, begin, end), at_back ? t[end - 1 - zone] : t[begin + zone], at_back, &segment);
     }
   }
 }
