@@ -756,7 +756,11 @@ std::optional<CurveWindow> FitCore(const WindowFitter& fitter, const Eigen::Vect
     push(Core{core.segment, a, middle, pieces, left_end, std::move(halves[0])});
   };
   const Eigen::Index inside = SamplesIn(t, a, b);
-  const bool may_split = inside >= 2 * options.min_window_samples;
+  // Halves of a core across a hole can be nearly empty (a lone sample joined to a segment across
+  // a gap): each must keep half the smallest window's samples.
+  const Eigen::Index smaller_half = std::min(SamplesIn(t, a, 0.5 * (a + b)), SamplesIn(t, 0.5 * (a + b), b));
+  const bool halves_hold = 2 * smaller_half >= options.min_window_samples;
+  const bool may_split = inside >= 2 * options.min_window_samples && halves_hold;
   // A window at an end of its segment whose degree exceeds end_degree is cut by RefineEnds when
   // it is accepted and split when it is not. When that degree is certain, it is cut here unfitted,
   // as RefineEnds would: the outer half is the end window to refine further (fitted without
@@ -764,7 +768,7 @@ std::optional<CurveWindow> FitCore(const WindowFitter& fitter, const Eigen::Vect
   // A whole segment is cut at its front first, like RefineEnds does.
   const bool front = a == segment.begin, back = b == segment.end;
   const bool refine_ends = options.end_degree > 0 && options.degree_method == DegreeMethod::kCrossValidation;
-  const bool refinable = refine_ends && (front || back) && inside >= EndWindowMinimum(options);
+  const bool refinable = refine_ends && (front || back) && inside >= EndWindowMinimum(options) && halves_hold;
   if (refinable && !fitted && fitter.DegreeCertainlyAbove(a, b, segment.begin, segment.end, options.end_degree)) {
     bool subsample_unresolved = false;
     if (end_piece || fitter.ResolvedAtTop(a, b, segment.begin, segment.end, &subsample_unresolved)) {

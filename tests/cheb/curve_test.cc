@@ -480,6 +480,31 @@ TEST(FitCurve, GapsSplitSegmentsAndAreNotBridged) {
   EXPECT_LT((v - Velocity(12.0)).norm(), 0.01);
 }
 
+// A lone sample between two gaps joins the segment across the shorter one, and that segment then
+// holds a hole: halving its core by time left a half with the lone sample alone, which could not be
+// fitted ("it has 1 distinct stamps", exit 3 from `cheval velocity` on 8 % of random recordings with
+// dropouts). Halves must keep samples.
+TEST(FitCurve, ASampleJoinedAcrossAGapIsNotLeftAloneInAWindow) {
+  const Samples s = Sample(3.0, 100.0, 5e-4, 21);
+  Samples holed;
+  holed.values.resize(static_cast<Eigen::Index>(s.stamps.size()), 3);
+  Eigen::Index n = 0;
+  for (size_t i = 0; i < s.stamps.size(); ++i) {
+    const double t = static_cast<double>(s.stamps[i] - kEpoch) * 1e-9;
+    // 0–0.02 s, a gap of 0.7 s, a lone sample at 0.73 s, a gap of 0.67 s, then 1.4–1.62 s.
+    const bool kept = t < 0.025 || std::abs(t - 0.73) < 0.001 || (t > 1.395 && t < 1.625);
+    if (!kept) continue;
+    holed.stamps.push_back(s.stamps[i]);
+    holed.values.row(n++) = s.values.row(static_cast<Eigen::Index>(i));
+  }
+  holed.values.conservativeResize(n, 3);
+  const Curve curve = FitCurve(holed.stamps, holed.values);
+  EXPECT_EQ(curve.segments().size(), 2u);
+  Eigen::VectorXd p(3), v(3), a(3);
+  EXPECT_NO_THROW(curve.Evaluate(kEpoch + 730'000'000LL, p, v, a));
+  EXPECT_TRUE(v.allFinite());
+}
+
 TEST(FitCurve, ErrorsOnWhatCannotBeFitted) {
   const std::vector<int64_t> one{kEpoch};
   EXPECT_THROW(FitCurve(one, Eigen::MatrixXd::Zero(1, 3)), ComputeError);
