@@ -460,18 +460,22 @@ TEST(FitCurve, UnsortedInputGivesTheSortedResult) {
   EXPECT_EQ(va, vb);
 }
 
-TEST(FitCurve, GapsSplitSegmentsAndAreNotBridged) {
-  Samples s = Sample(20.0, 100.0, 1e-4, 8);
-  Samples holed;
-  holed.values.resize(static_cast<Eigen::Index>(s.stamps.size()), 3);
+// The samples of `s` at the times t (s from kEpoch) that `keep` keeps.
+Samples Kept(const Samples& s, const std::function<bool(double)>& keep) {
+  Samples kept;
+  kept.values.resize(static_cast<Eigen::Index>(s.stamps.size()), 3);
   Eigen::Index n = 0;
   for (size_t i = 0; i < s.stamps.size(); ++i) {
-    const double t = (s.stamps[i] - kEpoch) * 1e-9;
-    if (t > 8.0 && t < 11.0) continue;  // a 3 s dropout
-    holed.stamps.push_back(s.stamps[i]);
-    holed.values.row(n++) = s.values.row(static_cast<Eigen::Index>(i));
+    if (!keep(static_cast<double>(s.stamps[i] - kEpoch) * 1e-9)) continue;
+    kept.stamps.push_back(s.stamps[i]);
+    kept.values.row(n++) = s.values.row(static_cast<Eigen::Index>(i));
   }
-  holed.values.conservativeResize(n, 3);
+  kept.values.conservativeResize(n, 3);
+  return kept;
+}
+
+TEST(FitCurve, GapsSplitSegmentsAndAreNotBridged) {
+  const Samples holed = Kept(Sample(20.0, 100.0, 1e-4, 8), [](double t) { return !(t > 8.0 && t < 11.0); });  // 3 s out
   const Curve curve = FitCurve(holed.stamps, holed.values);
   EXPECT_EQ(curve.segments().size(), 2u);
   Eigen::VectorXd p(3), v(3), a(3);
@@ -485,19 +489,10 @@ TEST(FitCurve, GapsSplitSegmentsAndAreNotBridged) {
 // fitted ("it has 1 distinct stamps", exit 3 from `cheval velocity` on 8 % of random recordings with
 // dropouts). Halves must keep samples.
 TEST(FitCurve, ASampleJoinedAcrossAGapIsNotLeftAloneInAWindow) {
-  const Samples s = Sample(3.0, 100.0, 5e-4, 21);
-  Samples holed;
-  holed.values.resize(static_cast<Eigen::Index>(s.stamps.size()), 3);
-  Eigen::Index n = 0;
-  for (size_t i = 0; i < s.stamps.size(); ++i) {
-    const double t = static_cast<double>(s.stamps[i] - kEpoch) * 1e-9;
-    // 0–0.02 s, a gap of 0.7 s, a lone sample at 0.73 s, a gap of 0.67 s, then 1.4–1.62 s.
-    const bool kept = t < 0.025 || std::abs(t - 0.73) < 0.001 || (t > 1.395 && t < 1.625);
-    if (!kept) continue;
-    holed.stamps.push_back(s.stamps[i]);
-    holed.values.row(n++) = s.values.row(static_cast<Eigen::Index>(i));
-  }
-  holed.values.conservativeResize(n, 3);
+  // 0–0.02 s, a gap of 0.7 s, a lone sample at 0.73 s, a gap of 0.67 s, then 1.4–1.62 s.
+  const Samples holed = Kept(Sample(3.0, 100.0, 5e-4, 21), [](double t) {
+    return t < 0.025 || std::abs(t - 0.73) < 0.001 || (t > 1.395 && t < 1.625);
+  });
   const Curve curve = FitCurve(holed.stamps, holed.values);
   EXPECT_EQ(curve.segments().size(), 2u);
   Eigen::VectorXd p(3), v(3), a(3);
