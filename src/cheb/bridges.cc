@@ -89,7 +89,8 @@ Bridge FitBridge(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Inde
   Eigen::VectorXd x(count);
   for (Eigen::Index i = 0; i < count; ++i) x[i] = interval.ToUnit(tw[i]);
   Bridge bridge{std::vector<int>(static_cast<size_t>(d), 1), Eigen::VectorXd(d), Eigen::VectorXd(d)};
-  Eigen::VectorXd best = Eigen::VectorXd::Constant(d, std::numeric_limits<double>::infinity()), rss(d);
+  Eigen::VectorXd best = Eigen::VectorXd::Constant(d, std::numeric_limits<double>::infinity());
+  Eigen::VectorXd rss = Eigen::VectorXd::Zero(d);
   for (int n = 1; n <= top; ++n) {
     // Residuals on the samples themselves: the sums of the normal equations lose nearly exact data's.
     const Eigen::VectorXd squares =
@@ -104,7 +105,7 @@ Bridge FitBridge(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Inde
     const int n = bridge.degrees[static_cast<size_t>(c)];
     bridge.residual_rms[c] = std::sqrt(rss[c] / static_cast<double>(count));
     bridge.lack_of_fit[c] = LackOfFitScore(rss[c], sigma[c], count - n - 1);
-    bridge.passes = bridge.passes && bridge.lack_of_fit[c] <= kLackOfFitLimit;
+    bridge.passes = bridge.passes && std::isfinite(best[c]) && bridge.lack_of_fit[c] <= kLackOfFitLimit;
   }
   return bridge;
 }
@@ -277,19 +278,27 @@ CurveWindow SideWindow(const Eigen::VectorXd& t, const GapFit& gap, bool back, E
 }
 
 // Puts `bridge` at the back (or front) of a segment, from `boundary` on (up to it): windows whose
-// core lies past the boundary go, the one holding it is cut there.
+// core lies past the boundary go, the one holding it is cut there. Nothing changes where no
+// window's core holds the boundary strictly inside (repeated stamps beside the gap).
 void Insert(CurveWindow bridge, double boundary, bool back, CurveSegment* segment) {
   std::vector<CurveWindow>& windows = segment->windows;
+  auto holds = [&](const CurveWindow& w) { return boundary > w.core_begin && boundary < w.core_end; };
   if (back) {
+    auto kept = windows.end();
+    while (kept != windows.begin() + 1 && std::prev(kept)->core_begin >= boundary) --kept;
+    if (!holds(*std::prev(kept))) return;
     bridge.core_begin = boundary;
     bridge.core_end = windows.back().core_end;
-    while (windows.size() > 1 && windows.back().core_begin >= boundary) windows.pop_back();
+    windows.erase(kept, windows.end());
     windows.back().core_end = boundary;
     windows.push_back(std::move(bridge));
   } else {
+    auto kept = windows.begin();
+    while (kept + 1 != windows.end() && kept->core_end <= boundary) ++kept;
+    if (!holds(*kept)) return;
     bridge.core_begin = windows.front().core_begin;
     bridge.core_end = boundary;
-    while (windows.size() > 1 && windows.front().core_end <= boundary) windows.erase(windows.begin());
+    windows.erase(windows.begin(), kept);
     windows.front().core_begin = boundary;
     windows.insert(windows.begin(), std::move(bridge));
   }
@@ -330,8 +339,7 @@ void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
     const GapFit* front = k > 0 && fits[k - 1] ? &*fits[k - 1] : nullptr;
     const GapFit* back = fits[k] ? &*fits[k] : nullptr;
     // A segment the fits of its gaps cover whole (one or both ends at a gap; a short segment
-    // between dropouts): those of them that help over all of it replace its windows, two blended
-    // across its middle.
+    // between dropouts): those of them that help over all of it replace its windows.
     const bool front_covers = front != nullptr && front->first + front->count >= end;
     const bool back_covers = back != nullptr && back->first <= begin;
     const bool front_whole = front_covers && SideHelps(t, z, *front, false, begin, end, segment, begin, n);
@@ -342,7 +350,10 @@ void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
       if (back_whole) windows.push_back(SideWindow(t, *back, true, begin, end));
       windows.front().core_begin = segment.windows.front().core_begin;
       windows.back().core_end = segment.windows.back().core_end;
-      if (windows.size() == 2) windows[0].core_end = windows[1].core_begin = t[begin + (n - 1) / 2];
+      // The two meet half-way in time (each then blends over a quarter of the segment); a segment
+      // of one stamp has no middle, and keeps the first.
+      if (windows.size() == 2 && !(t[end - 1] > t[begin])) windows.pop_back();
+      if (windows.size() == 2) windows[0].core_end = windows[1].core_begin = 0.5 * (t[begin] + t[end - 1]);
       segment.windows = std::move(windows);
     }
     // Otherwise each end's own: alone over z/2 samples from the gap, blended up to 1.5z, z a third
@@ -351,7 +362,7 @@ void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
     const GapFit* whole = front_whole ? front : back_whole ? back : nullptr;
     for (const bool at_back : {true, false}) {
       const GapFit* gap = at_back ? back : front;
-      if (gap == nullptr || gap == whole) continue;
+      if (gap == nullptr || (at_back ? back_whole : front_whole)) continue;
       if ((at_back ? back_covers : front_covers) &&
           !ResidualTrendIsNoise(t, z, begin, n, gap->sides[at_back ? 0 : 1], gap->sigma)) {
         continue;

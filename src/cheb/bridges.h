@@ -28,11 +28,11 @@ namespace cheval::cheb::internal {
 ///      slope is the noise's; on nearly noise-free data it is the bias of a fit held to a hole's
 ///      low degree, where the segment's own end is exact.
 /// A segment that the fits of its gaps cover whole (a short one between dropouts) is replaced by
-/// them, blended across its middle, where each helps over all of it (and has the smaller variance
-/// at both its ends). Otherwise a side becomes the segment's last (or first) window, re-expanded
-/// exactly on the segment's samples it covers, as an end cap does: alone over the z/2 samples next to the gap
-/// and blended into the segment's windows up to 1.5z, z a third of its samples within reach (and
-/// of the segment's). Its verdict is WindowVerdict::kBridge.
+/// those that help over all of it (with the smaller variance at both its ends), two meeting
+/// half-way in time. Otherwise a side becomes the segment's last (or first) window, re-expanded
+/// exactly on the segment's samples it covers, as an end cap does: alone over the z/2 samples
+/// next to the gap and blended into the segment's windows up to 1.5z, z a third of its samples
+/// within reach (and of the segment's). Its verdict is WindowVerdict::kBridge.
 ///
 /// `t` (sorted, s) and `z` are the curve's samples, `starts` the segments' first samples followed
 /// by the sample count, `segments` their fits (ends capped; a segment that `continues` ends at a
