@@ -1,4 +1,5 @@
 #include "bridges.h"
+#include "local_rates.h"
 #include "residual_test.h"
 #include "work_queue.h"
 
@@ -29,19 +30,18 @@ constexpr double kTrendLimit = 3.0;
 // N²/m of a fit across a gap at most, as the windows' (CurveOptions::max_conditioning's default).
 constexpr double kMaxConditioning = 8.0;
 
-// d/dt of T_0..T_top at t on `interval`: k U_{k-1}(x) · dx/dt (U of the second kind).
-Eigen::VectorXd DerivativeBasis(const Interval& interval, double t, int top) {
-  const double x = interval.ToUnit(t), scale = interval.DerivativeScale();
+// The variance factor dᵀG⁻¹d of the rate at `at` per coordinate, of fits on `interval` of the
+// given degrees whose normal matrix `cholesky` factors (d the derivative's basis there: times σ²,
+// the rate's variance).
+Eigen::VectorXd RateVarianceFactor(const NestedCholesky& cholesky, const Interval& interval,
+                                   const std::vector<int>& degrees, double at) {
+  const int top = cholesky.degree();
   Eigen::VectorXd basis(top + 1);
-  basis[0] = 0.0;
-  double u_previous = 0.0, u = 1.0;  // U_{k-2}, U_{k-1}
-  for (int k = 1; k <= top; ++k) {
-    basis[k] = k * u * scale;
-    const double next = 2.0 * x * u - u_previous;
-    u_previous = u;
-    u = next;
-  }
-  return basis;
+  ChebyshevSlopes(interval.ToUnit(at), interval.DerivativeScale(), basis);
+  const Eigen::VectorXd whitened = cholesky.Whiten(top, basis);
+  Eigen::VectorXd factor(static_cast<Eigen::Index>(degrees.size()));
+  for (Eigen::Index c = 0; c < factor.size(); ++c) factor[c] = whitened.head(degrees[static_cast<size_t>(c)] + 1).squaredNorm();
+  return factor;
 }
 
 // A least-squares fit of samples [first, first + count) with a degree per coordinate, and the
@@ -59,13 +59,10 @@ SideFit FitAt(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index f
   const int top = *std::max_element(degrees.begin(), degrees.end());
   const NormalEquations normal = BuildNormalEquations(t.segment(first, count), z.middleRows(first, count), top, interval);
   const NestedCholesky cholesky(normal, top);
-  const Eigen::VectorXd basis = DerivativeBasis(interval, at, top);
-  const Eigen::MatrixXd whitened = cholesky.Whiten(top, basis);
-  SideFit fit{interval, Eigen::MatrixXd::Zero(top + 1, d), Eigen::VectorXd(d)};
+  SideFit fit{interval, Eigen::MatrixXd::Zero(top + 1, d), RateVarianceFactor(cholesky, interval, degrees, at)};
   for (Eigen::Index c = 0; c < d; ++c) {
     const int n = degrees[static_cast<size_t>(c)];
     fit.coefficients.col(c).head(n + 1) = cholesky.Solve(n, normal.rhs.col(c));
-    fit.rate_variance_factor[c] = whitened.col(0).head(n + 1).squaredNorm();
   }
   return fit;
 }
@@ -142,18 +139,6 @@ CurveWindow SideWindow(const Eigen::VectorXd& t, const SideFit& fit, const Bridg
   return window;
 }
 
-// The rate's variance factor of a segment's end window at time `at`, fitted again to its samples
-// [first, first + count) (the segment's samples inside its fit interval).
-std::optional<Eigen::VectorXd> EndVarianceFactor(const Eigen::VectorXd& t, const Eigen::MatrixXd& z,
-                                                 Eigen::Index first, Eigen::Index count, const CurveWindow& window,
-                                                 double at) {
-  try {
-    return FitAt(t, z, first, count, window.series.interval, window.degrees, at).rate_variance_factor;
-  } catch (const ComputeError&) {
-    return std::nullopt;  // repeated stamps: the end window's samples do not determine it again
-  }
-}
-
 // A gap's fit and its two sides: the back of the segment before (side 0) and the front of the
 // one after (side 1).
 struct GapFit {
@@ -223,14 +208,14 @@ bool ResidualTrendIsNoise(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Ei
 }
 
 // The rate's variance factor of the segment [begin, end)'s own fit at its sample `at`: that of the
-// window at that end, fitted again to its samples.
-std::optional<Eigen::VectorXd> OwnVarianceFactor(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index begin,
-                                                 Eigen::Index end, const CurveSegment& segment, Eigen::Index at) {
-  const double* data = t.data();
+// window at that end, fitted again to its samples; none where they no longer determine it.
+std::optional<Eigen::VectorXd> OwnVarianceFactor(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index end,
+                                                 const CurveSegment& segment, Eigen::Index at) {
   const CurveWindow& own = at + 1 == end ? segment.windows.back() : segment.windows.front();
-  const Eigen::Index own_first = std::lower_bound(data + begin, data + end, own.fit_begin) - data;
-  const Eigen::Index own_count = std::upper_bound(data + begin, data + end, own.fit_end) - data - own_first;
-  return EndVarianceFactor(t, z, own_first, own_count, own, t[at]);
+  const std::optional<NestedCholesky> cholesky =
+      FactorWindow(t, z, own, *std::max_element(own.degrees.begin(), own.degrees.end()));
+  if (!cholesky) return std::nullopt;
+  return RateVarianceFactor(*cholesky, own.series.interval, own.degrees, t[at]);
 }
 
 // Whether a gap's side may stand in for the segment [begin, end) it borders (`back`: at the
@@ -250,7 +235,7 @@ bool SideHelps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const GapFit&
         incumbent != nullptr ? FitAt(t, z, incumbent->first, incumbent->count, incumbent->sides[0].interval,
                                      incumbent->bridge.degrees, t[at])
                                    .rate_variance_factor
-                             : OwnVarianceFactor(t, z, begin, end, segment, at);
+                             : OwnVarianceFactor(t, z, end, segment, at);
     const Eigen::VectorXd factor =
         at == (back ? end - 1 : begin)
             ? fit.rate_variance_factor
