@@ -30,20 +30,6 @@ constexpr double kTrendLimit = 3.0;
 // N²/m of a fit across a gap at most, as the windows' (CurveOptions::max_conditioning's default).
 constexpr double kMaxConditioning = 8.0;
 
-// The variance factor dᵀG⁻¹d of the rate at `at` per coordinate, of fits on `interval` of the
-// given degrees whose normal matrix `cholesky` factors (d the derivative's basis there: times σ²,
-// the rate's variance).
-Eigen::VectorXd RateVarianceFactor(const NestedCholesky& cholesky, const Interval& interval,
-                                   const std::vector<int>& degrees, double at) {
-  const int top = cholesky.degree();
-  Eigen::VectorXd basis(top + 1);
-  ChebyshevSlopes(interval.ToUnit(at), interval.DerivativeScale(), basis);
-  const Eigen::VectorXd whitened = cholesky.Whiten(top, basis);
-  Eigen::VectorXd factor(static_cast<Eigen::Index>(degrees.size()));
-  for (Eigen::Index c = 0; c < factor.size(); ++c) factor[c] = whitened.head(degrees[static_cast<size_t>(c)] + 1).squaredNorm();
-  return factor;
-}
-
 // A least-squares fit of samples [first, first + count) with a degree per coordinate, and the
 // variance factor dᵀG⁻¹d of its rate at one time per coordinate (d the derivative's basis there:
 // times σ², the rate's variance).

@@ -1210,7 +1210,8 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     };
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
       const bool front_at_jump = k > 0 && curve.segments_[k - 1].continues;
-      internal::AddEndCaps(t, z, velocity, starts[k], starts[k + 1], front_at_jump, &curve.segments_[k], threads);
+      internal::AddEndCaps(t, z, velocity, starts[k], starts[k + 1], front_at_jump, options.short_segment_caps,
+                           &curve.segments_[k], threads);
     }
     // Then fits across the gaps take over the segments' ends where they are the better estimate.
     internal::BridgeGaps(t, z, starts, profile, curve.rounding_, &curve.segments_, threads);

@@ -1,10 +1,12 @@
 #include "end_caps.h"
+#include "local_rates.h"
 #include "work_queue.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "cheval/cheb/chebyshev.h"
@@ -33,6 +35,9 @@ constexpr std::array<int, 11> kCapBoundaries{4, 6, 8, 11, 16, 23, 32, 45, 64, 91
 // Artificial ends per direction (pooled: 2 x 32 one-sided fits per candidate and end; 64 gave the
 // same errors on the benchmark within ±0.2 % in geometric mean, at twice the cost).
 constexpr int kArtificialEnds = 32;
+// Inside a short segment's end window (its middle half, a few dozen samples), 16 gave the same
+// errors as 32 on clips of 0.3–2 s (docs/decisions.md) at less cost.
+constexpr int kArtificialEndsInWindow = 16;
 
 // Samples read from an end inward as if they were a segment's first ones: τ ≥ 0 (s from the end),
 // the values, and the reference velocity d/dτ at the first `offsets` of them (negated when read
@@ -95,7 +100,6 @@ class OneSidedFits {
   Eigen::MatrixXd Velocity(int degree, Eigen::Index count) const {
     return derivative_basis_.topLeftCorner(count, degree + 1).lazyProduct(cholesky_.Solve(degree, normal_.rhs));
   }
-
  private:
   // Above this many sample-degree products the library's vectorised accumulation is faster.
   static constexpr Eigen::Index kMomentLoopLimit = 2048;
@@ -144,6 +148,8 @@ Eigen::Index BlendEnd(int z) { return static_cast<Eigen::Index>(std::ceil(1.5 * 
 // A cap candidate and its pooled statistics over the artificial ends, per offset and coordinate:
 // a = Σ Δ², b = Σ Δ·e with Δ = v_cap − v_end and e = v_end − v_reference. The blended velocity
 // v_end + wΔ has the error e + wΔ, so the cap changes the summed squared error by Σ w²a + 2w·b.
+// Where the end window's rate is the reference itself (a segment of one or two windows), e = 0
+// and a is the cap's squared error.
 struct Candidate {
   int samples = 0, degree = 0;
   Eigen::Index offsets = 0;  // velocities compared at offsets 0..offsets-1
@@ -156,22 +162,57 @@ struct Choice {
   std::vector<int> degrees;  // per coordinate; -1 keeps the end window's polynomial
 };
 
-// Chooses the cap of one end (front: the segment's start) from the artificial ends in [lo, hi).
-Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const VelocityAt& velocity, Eigen::Index lo,
-                 Eigen::Index hi, Eigen::Index segment_samples, const CurveWindow& end, Eigen::Index end_samples,
-                 Eigen::Index core_samples, int shortest) {
-  const Eigen::Index d = z.cols(), room = hi - lo;
-  auto boundary_allowed = [&](int m, int boundary) { return 1.5 * boundary <= m - 1 && 2 * boundary <= core_samples; };
+// Where the artificial ends of a segment lie: the velocities are compared at samples [lo, hi), where
+// the curve's velocity is an interior one, and the one-sided fits read samples [block_lo, block_hi).
+struct ArtificialEnds {
+  Eigen::Index lo = 0, hi = 0, block_lo = 0, block_hi = 0;
+};
+
+// Adds one artificial end's block to the candidates' statistics, with the end window's velocity
+// at its offsets.
+void Pool(const Block& block, const Eigen::MatrixXd& end_velocity, std::vector<Candidate>& candidates) {
+  const Eigen::MatrixXd end_error = end_velocity - block.v;
+  std::vector<Eigen::MatrixXd> deltas;
+  for (size_t i = 0; i < candidates.size();) {
+    const int m = candidates[i].samples;
+    size_t j = i;
+    while (j < candidates.size() && candidates[j].samples == m) ++j;
+    const OneSidedFits fits(block, m, candidates[j - 1].degree, candidates[i].offsets);
+    for (; i < j; ++i) {
+      const Eigen::Index n = candidates[i].offsets;
+      deltas.push_back(fits.Velocity(candidates[i].degree, n) - end_velocity.topRows(n));
+    }
+  }
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    const Eigen::Index n = candidates[i].offsets;
+    candidates[i].a += deltas[i].cwiseAbs2();
+    candidates[i].b += deltas[i].cwiseProduct(end_error.topRows(n));
+  }
+}
+
+// Chooses the cap of one end (front: the segment's start) at the artificial ends `ends`. A cap is
+// compared with the end window's own configuration, fitted one-sidedly at the artificial ends
+// too. An end window whose rate is the reference there cannot be, and `end_variance` (offsets x d)
+// gives its rate's variance at the real end's samples instead: its error there, but for a bias.
+Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const VelocityAt& velocity,
+                 const ArtificialEnds& ends, Eigen::Index segment_samples, const CurveWindow& end,
+                 Eigen::Index end_samples, Eigen::Index core_samples, int shortest,
+                 const Eigen::MatrixXd* end_variance) {
+  const Eigen::Index d = z.cols(), room = ends.hi - ends.lo, block_room = ends.block_hi - ends.block_lo;
+  auto boundary_allowed = [&](int m, int boundary) {
+    return 1.5 * boundary <= m - 1 && 2 * boundary <= core_samples &&
+           (end_variance == nullptr || BlendEnd(boundary) <= end_variance->rows());
+  };
   std::vector<Candidate> candidates;
-  Eigen::Index block_samples = end_samples, end_offsets = 0;
+  Eigen::Index block_samples = end_variance == nullptr ? end_samples : 0, end_offsets = 0;
   for (const int m : kCapSamples) {
     if (m < shortest) continue;
-    if (m > room || 2 * m > segment_samples) break;
+    if (m > block_room || 2 * m > segment_samples) break;
     Eigen::Index offsets = 0;
     for (const int boundary : kCapBoundaries) {
       if (boundary_allowed(m, boundary)) offsets = BlendEnd(boundary);
     }
-    if (offsets == 0) continue;
+    if (offsets == 0 || offsets > room) continue;
     for (const int p : kCapDegrees) {
       if (m >= kLongCap ? 4 * (p + 1) > m : p + 3 > m) break;
       candidates.push_back({m, p, offsets, Eigen::MatrixXd::Zero(offsets, d), Eigen::MatrixXd::Zero(offsets, d)});
@@ -179,36 +220,28 @@ Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloc
     block_samples = std::max<Eigen::Index>(block_samples, m);
     end_offsets = std::max(end_offsets, offsets);
   }
-  if (candidates.empty() || block_samples > room || end_offsets > end_samples) return {};
+  if (candidates.empty() || block_samples > block_room || end_offsets > room) return {};
+  if (end_variance == nullptr && end_offsets > end_samples) return {};
 
   const int end_top = *std::max_element(end.degrees.begin(), end.degrees.end());
   int pooled = 0;
   for (const bool backwards : {false, true}) {
-    const Eigen::Index first = backwards ? lo + block_samples - 1 : lo, span = room - block_samples;
-    const Eigen::Index count = std::min<Eigen::Index>(kArtificialEnds, span + 1);
+    // An artificial end's offsets lie in [lo, hi), its block in [block_lo, block_hi).
+    const Eigen::Index first = backwards ? std::max(ends.lo + end_offsets, ends.block_lo + block_samples) - 1 : ends.lo;
+    const Eigen::Index last = backwards ? ends.hi - 1 : std::min(ends.hi - end_offsets, ends.block_hi - block_samples);
+    if (last < first) continue;
+    const Eigen::Index span = last - first;
+    const Eigen::Index count = std::min<Eigen::Index>(end_variance ? kArtificialEndsInWindow : kArtificialEnds, span + 1);
     for (Eigen::Index k = 0; k < count; ++k) {
       const Eigen::Index start = first + (count > 1 ? k * span / (count - 1) : 0);
       const Block block = ReadBlock(t, z, velocity, start, block_samples, end_offsets, backwards);
       try {
+        // Against the reference itself, the end window's error is none.
         const Eigen::MatrixXd end_velocity =
-            OneSidedFits(block, end_samples, end_top, end_offsets).Velocity(end.degrees, end_offsets);
-        const Eigen::MatrixXd end_error = end_velocity - block.v;
-        std::vector<Eigen::MatrixXd> deltas;
-        for (size_t i = 0; i < candidates.size();) {
-          const int m = candidates[i].samples;
-          size_t j = i;
-          while (j < candidates.size() && candidates[j].samples == m) ++j;
-          const OneSidedFits fits(block, m, candidates[j - 1].degree, candidates[i].offsets);
-          for (; i < j; ++i) {
-            const Eigen::Index n = candidates[i].offsets;
-            deltas.push_back(fits.Velocity(candidates[i].degree, n) - end_velocity.topRows(n));
-          }
-        }
-        for (size_t i = 0; i < candidates.size(); ++i) {
-          const Eigen::Index n = candidates[i].offsets;
-          candidates[i].a += deltas[i].cwiseAbs2();
-          candidates[i].b += deltas[i].cwiseProduct(end_error.topRows(n));
-        }
+            end_variance != nullptr
+                ? block.v
+                : OneSidedFits(block, end_samples, end_top, end_offsets).Velocity(end.degrees, end_offsets);
+        Pool(block, end_velocity, candidates);
         ++pooled;
       } catch (const ComputeError&) {
         // A singular one-sided fit (repeated stamps): this artificial end is left out for all.
@@ -228,6 +261,18 @@ Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloc
       Eigen::VectorXd w(n);
       for (Eigen::Index o = 0; o < n; ++o) w[o] = CapWeight(o, boundary);
       Choice choice{0.0, m, boundary, std::vector<int>(d, -1)};
+      // The change of the summed squared error over offsets 0..n-1 of candidate k's coordinate c.
+      auto gain_of = [&](size_t k, Eigen::Index c) {
+        if (end_variance == nullptr) {
+          return w.cwiseAbs2().dot(candidates[k].a.col(c).head(n)) + 2.0 * w.dot(candidates[k].b.col(c).head(n));
+        }
+        // The cap's pooled squared error against the end window's variance at the real end. The
+        // two errors at a sample are not independent, so the blend's is bounded by Cauchy–Schwarz.
+        const Eigen::ArrayXd own = end_variance->col(c).head(n).array();
+        const Eigen::ArrayXd cap = candidates[k].a.col(c).head(n).array() / pooled;
+        const Eigen::ArrayXd blended = (1.0 - w.array()) * own.sqrt() + w.array() * cap.sqrt();
+        return (blended.square() - own).sum();
+      };
       for (Eigen::Index c = 0; c < d; ++c) {
         // Keeping the end window's polynomial changes nothing, but only a cap within the end
         // window's samples can keep it: re-expanded over a longer interval, the polynomial is
@@ -235,8 +280,7 @@ Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloc
         // whose cancellation left the rate 3,000 m/s off on a 0.5 m/s sine).
         double lowest = m <= end_samples ? 0.0 : std::numeric_limits<double>::infinity();
         for (size_t k = i; k < j; ++k) {
-          const double gain =
-              w.cwiseAbs2().dot(candidates[k].a.col(c).head(n)) + 2.0 * w.dot(candidates[k].b.col(c).head(n));
+          const double gain = gain_of(k, c);
           if (gain < lowest) lowest = gain, choice.degrees[c] = candidates[k].degree;
         }
         choice.gain += lowest;
@@ -296,30 +340,74 @@ CurveWindow BuildCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::
   return cap;
 }
 
+// The rate of `window` at samples first .. first + count - 1.
+Eigen::MatrixXd WindowRate(const Eigen::VectorXd& t, const CurveWindow& window, Eigen::Index first, Eigen::Index count) {
+  const Interval& interval = window.series.interval;
+  Eigen::VectorXd x(count);
+  for (Eigen::Index i = 0; i < count; ++i) x[i] = interval.ToUnit(t[first + i]);
+  return EvaluateSeries(window.first_derivative, x) * interval.DerivativeScale();
+}
+
+// The variance of `window`'s rate at `count` samples from `at` on in direction `step` (±1), per
+// coordinate: σ²·dᵀG⁻¹d with the window's σ; none where its samples no longer determine it.
+std::optional<Eigen::MatrixXd> RateVariance(const Eigen::VectorXd& t, const Eigen::MatrixXd& z,
+                                            const CurveWindow& window, Eigen::Index at, int step, Eigen::Index count) {
+  const std::optional<NestedCholesky> cholesky =
+      FactorWindow(t, z, window, *std::max_element(window.degrees.begin(), window.degrees.end()));
+  if (!cholesky || window.noise_sigma.size() != z.cols()) return std::nullopt;
+  Eigen::MatrixXd variance(count, z.cols());
+  for (Eigen::Index o = 0; o < count; ++o) {
+    variance.row(o) = RateVarianceFactor(*cholesky, window.series.interval, window.degrees, t[at + step * o])
+                          .cwiseProduct(window.noise_sigma.cwiseAbs2())
+                          .transpose();
+  }
+  return variance;
+}
+
 }  // namespace
 
 void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const VelocityAt& velocity, Eigen::Index first,
-                Eigen::Index last, bool front_at_jump, CurveSegment* segment, int threads) {
+                Eigen::Index last, bool front_at_jump, bool short_segments, CurveSegment* segment, int threads) {
   std::vector<CurveWindow>& windows = segment->windows;
-  if (windows.size() < 3) return;
+  if (windows.empty() || (windows.size() < 3 && !short_segments)) return;
   const double* begin = t.data() + first;
   const double* end = t.data() + last;
   auto samples_in = [&](double a, double b) {
     return std::upper_bound(begin, end, b) - std::lower_bound(begin, end, a);
   };
-  // Artificial ends lie where the curve's velocity is an interior one: off both end windows.
-  const Eigen::Index lo = std::upper_bound(begin, end, windows.front().fit_end) - t.data();
-  const Eigen::Index hi = std::lower_bound(begin, end, windows.back().fit_begin) - t.data();
-  if (hi <= lo) return;
+  // Artificial ends lie where the curve's velocity is an interior one: off both end windows. In a
+  // segment of one or two windows, there is no such place: each end's artificial ends lie in the
+  // middle half of its end window's samples, where that window's rate varies least, and its rate is
+  // the reference there.
+  const bool spanned = windows.size() <= 2;
+  const ArtificialEnds interior{std::upper_bound(begin, end, windows.front().fit_end) - t.data(),
+                                std::lower_bound(begin, end, windows.back().fit_begin) - t.data(), 0, 0};
+  if (!spanned && interior.hi <= interior.lo) return;
   std::array<Choice, 2> choices;
   ParallelFor(2, threads, [&](int side) {
     const bool front = side == 0;
     const CurveWindow& w = front ? windows.front() : windows.back();
     const Eigen::Index end_samples = samples_in(w.fit_begin, w.fit_end);
     const Eigen::Index core_samples = samples_in(w.core_begin, w.core_end);
-    const bool at_jump = front ? front_at_jump : segment->continues;
-    choices[static_cast<size_t>(side)] =
-        ChooseCap(t, z, velocity, lo, hi, last - first, w, end_samples, core_samples, at_jump ? kLongCap : 0);
+    const int shortest = (front ? front_at_jump : segment->continues) ? kLongCap : 0;
+    if (!spanned) {
+      choices[static_cast<size_t>(side)] = ChooseCap(t, z, velocity, {interior.lo, interior.hi, interior.lo, interior.hi},
+                                                     last - first, w, end_samples, core_samples, shortest, nullptr);
+      return;
+    }
+    // The end window's rate at the real end's samples, and its variance there.
+    const Eigen::Index offsets = std::min(end_samples / 2, BlendEnd(kCapBoundaries.back()));
+    const std::optional<Eigen::MatrixXd> end_variance =
+        RateVariance(t, z, w, front ? first : last - 1, front ? 1 : -1, offsets);
+    if (!end_variance) return;  // its samples no longer determine the window (repeated stamps)
+    const Eigen::Index wf = std::lower_bound(begin, end, w.fit_begin) - t.data(), wl = wf + end_samples;
+    const ArtificialEnds ends{wf + end_samples / 4, wl - end_samples / 4, wf, wl};
+    if (ends.hi <= ends.lo) return;
+    const VelocityAt own_velocity = [&](Eigen::Index from, Eigen::Index count) {
+      return WindowRate(t, w, from, count);
+    };
+    choices[static_cast<size_t>(side)] = ChooseCap(t, z, own_velocity, ends, end_samples, w, end_samples,
+                                                   core_samples, shortest, &*end_variance);
   });
   // The back first, so that inserting at the front leaves nothing to re-find.
   for (const bool front : {false, true}) {

@@ -26,14 +26,21 @@ using VelocityAt = std::function<Eigen::MatrixXd(Eigen::Index first, Eigen::Inde
 /// a degree per coordinate; a coordinate for which no cap is estimated to help keeps the end
 /// window's own polynomial inside the cap. A cap is added only when it lowers the pooled error.
 ///
+/// A segment of one or two windows has no interior off its end windows. With `short_segments`,
+/// each end's artificial ends then lie in the middle half of its end window's samples, where that
+/// window's rate is the reference (its variance there is a fraction of the end's); the window's own
+/// error at the real end, which no artificial end reproduces, is taken as its rate's variance there
+/// (σ²·dᵀG⁻¹d with the window's σ, without a bias), and a cap is added where the blend of the two
+/// errors (bounded by Cauchy–Schwarz, as they are not independent) is estimated to be smaller.
+///
 /// `t` (sorted, s) and `z` (m x d) are the curve's samples, `velocity` gives the fitted curve's
 /// velocity at them (asked only where the artificial ends need it), [first, last) the segment's
 /// samples; `front_at_jump` says the segment starts at a jump (its end at one: `continues`), where
 /// no cap shorter than 16 samples is tried. The cap becomes the segment's first (or last) window;
-/// the neighbouring end window's core is shortened to make room. Segments too short for artificial ends (fewer than three
-/// windows, or an interior shorter than the windows) are left as they are. The two ends' caps are
-/// chosen on up to `threads` threads (`velocity` is then called concurrently).
+/// the neighbouring end window's core is shortened to make room. Segments too short for artificial
+/// ends are left as they are. The two ends' caps are chosen on up to `threads` threads (`velocity`
+/// is then called concurrently).
 void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const VelocityAt& velocity, Eigen::Index first,
-                Eigen::Index last, bool front_at_jump, CurveSegment* segment, int threads = 1);
+                Eigen::Index last, bool front_at_jump, bool short_segments, CurveSegment* segment, int threads = 1);
 
 }  // namespace cheval::cheb::internal

@@ -159,6 +159,17 @@ void ChebyshevSlopes(double x, double scale, Eigen::Ref<Eigen::VectorXd> slopes)
   slopes *= scale;
 }
 
+Eigen::VectorXd RateVarianceFactor(const NestedCholesky& cholesky, const Interval& interval,
+                                   const std::vector<int>& degrees, double at) {
+  const int top = cholesky.degree();
+  Eigen::VectorXd basis(top + 1);
+  ChebyshevSlopes(interval.ToUnit(at), interval.DerivativeScale(), basis);
+  const Eigen::VectorXd whitened = cholesky.Whiten(top, basis);
+  Eigen::VectorXd factor(static_cast<Eigen::Index>(degrees.size()));
+  for (Eigen::Index c = 0; c < factor.size(); ++c) factor[c] = whitened.head(degrees[static_cast<size_t>(c)] + 1).squaredNorm();
+  return factor;
+}
+
 std::pair<Eigen::Index, Eigen::Index> SamplesOf(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
                                                 const LocalRun& run) {
   const double* begin = t.data() + first;

@@ -29,6 +29,12 @@ std::optional<NestedCholesky> FactorWindow(const Eigen::VectorXd& t, const Eigen
 /// derivatives at x in [−1, 1], by the U recurrence (`scale` the interval's DerivativeScale gives d/dt).
 void ChebyshevSlopes(double x, double scale, Eigen::Ref<Eigen::VectorXd> slopes);
 
+/// The variance factor dᵀG⁻¹d of the rate at time `at` (s) per coordinate, of fits on `interval` of
+/// the given degrees whose normal matrix `cholesky` factors (d the derivative's basis there): times
+/// σ², the rate's variance.
+Eigen::VectorXd RateVarianceFactor(const NestedCholesky& cholesky, const Interval& interval, const std::vector<int>& degrees,
+                                   double at);
+
 /// The samples of a segment (n from `first` in the sorted stamps `t`) that a run spans, [from, to).
 std::pair<Eigen::Index, Eigen::Index> SamplesOf(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
                                                 const LocalRun& run);

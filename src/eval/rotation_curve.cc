@@ -105,6 +105,10 @@ RotationCurve FitRotationCurve(std::span<const int64_t> stamps_ns, std::span<con
   // handheld's body rate 15–25 % worse).
   cheb::CurveOptions chart_options = options.curve;
   chart_options.min_window_samples = std::max<int>(chart_options.min_window_samples, kMinPieceSamples);
+  // A piece's end lies where it is blended with the next, and its noise is largest there: the caps
+  // of pieces of one or two windows, judged by one σ, made the drone's body rate 49 % worse
+  // (docs/decisions.md).
+  chart_options.short_segment_caps = false;
   RotationCurve curve;
   curve.origin_ns_ = stamps.front();
   for (const Piece& piece : CutPieces(stamps, sorted, options.max_chart_angle, kMinPieceSamples)) {

@@ -289,19 +289,41 @@ TEST(FitCurve, EndCapsAreWindowsThatTileTheSegmentAndJoinSmoothly) {
   }
 }
 
-TEST(FitCurve, EndCapsKeepNoiseFreeFitsExactAndSkipShortRecordings) {
-  // Noise-free: whatever cap is chosen must not spoil a spectrally accurate fit.
-  const Samples exact = Sample(10.0, 200.0, 0.0, 1);
-  EXPECT_LT(VelocityRmse(FitCurve(exact.stamps, exact.values), exact), 1e-6);
-  // A recording of one or two windows has no interior to place artificial ends in: unchanged.
-  const Samples short_noisy = Sample(1.0, 100.0, 1e-3, 2);
-  CurveOptions without;
-  without.end_caps = false;
-  const Curve a = FitCurve(short_noisy.stamps, short_noisy.values);
-  const Curve b = FitCurve(short_noisy.stamps, short_noisy.values, without);
-  ASSERT_LT(b.segments()[0].windows.size(), 3u);
-  EXPECT_EQ(a.segments()[0].windows.size(), b.segments()[0].windows.size());
-  EXPECT_EQ(VelocityRmse(a, short_noisy), VelocityRmse(b, short_noisy));
+TEST(FitCurve, EndCapsKeepNoiseFreeFitsExact) {
+  // Noise-free: whatever cap is chosen must not spoil a spectrally accurate fit, in a long
+  // recording or in one of a single window.
+  for (const double duration : {10.0, 1.0}) {
+    const Samples exact = Sample(duration, 200.0, 0.0, 1);
+    EXPECT_LT(VelocityRmse(FitCurve(exact.stamps, exact.values), exact), 1e-6) << duration << " s";
+  }
+}
+
+// A short noisy recording is one or two windows, whose rate at the ends has a variance growing like
+// N⁴/m: caps chosen inside its end windows ("End caps") take over there. Pooled over 40 draws of
+// 0.5–2 s under 1–2 mm, the velocity error falls (by 2–20 %; without short_segment_caps the curve
+// is the one cheval fitted before such caps).
+TEST(FitCurve, EndCapsTakeOverTheEndsOfShortNoisyRecordings) {
+  for (const double duration : {0.5, 1.0, 2.0}) {
+    for (const double noise : {1e-3, 2e-3}) {
+      double capped = 0.0, uncapped = 0.0;
+      int with_caps = 0;
+      for (uint64_t seed = 1; seed <= 40; ++seed) {
+        const Samples s = Sample(duration, 100.0, noise, seed);
+        CurveOptions without;
+        without.short_segment_caps = false;
+        const Curve a = FitCurve(s.stamps, s.values);
+        const Curve b = FitCurve(s.stamps, s.values, without);
+        with_caps += a.segments()[0].windows.size() > b.segments()[0].windows.size() ? 1 : 0;
+        capped += std::pow(VelocityRmse(a, s), 2);
+        uncapped += std::pow(VelocityRmse(b, s), 2);
+      }
+      SCOPED_TRACE(testing::Message() << duration << " s under " << noise * 1e3 << " mm: " << std::sqrt(capped / 40) * 1e3
+                                      << " mm/s with caps in " << with_caps << " of 40, "
+                                      << std::sqrt(uncapped / 40) * 1e3 << " without");
+      EXPECT_GT(with_caps, 10);
+      EXPECT_LT(capped, uncapped);
+    }
+  }
 }
 
 // Six tones per axis up to `fraction` of the rate (one at it), ~0.3 m/s, under `noise`, 20 s at

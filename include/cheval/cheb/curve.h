@@ -70,11 +70,15 @@ struct CurveOptions {
   /// velocity error: the cap's length, blending boundary and degrees are chosen by one-sided fits
   /// at artificial ends inside the segment, checked against the curve's interior velocity there
   /// (docs/velocity.md, "End caps"). Adaptive windows only (not with window_s, single_window or a
-  /// fixed degree, which ask for a literal fit); segments need at least three windows. At a gap, a
-  /// fit across it takes over a segment's end where the data on both sides say it is the better
-  /// estimate (docs/velocity.md, "Gaps"; WindowVerdict::kBridge). false keeps the end windows' own
-  /// polynomials.
+  /// fixed degree, which ask for a literal fit). At a gap, a fit across it takes over a segment's
+  /// end where the data on both sides say it is the better estimate (docs/velocity.md, "Gaps";
+  /// WindowVerdict::kBridge). false keeps the end windows' own polynomials.
   bool end_caps = true;
+  /// With end_caps, segments of one or two windows get caps too: chosen at artificial ends inside
+  /// the end window, where its own rate is the reference, and against its rate's variance at the
+  /// end, σ²·dᵀG⁻¹d with the window's σ. The angular fit turns it off: its charts' noise varies
+  /// along them (largest at their ends), and a chart's end lies where it is blended with the next.
+  bool short_segment_caps = true;
   /// Fit a single window over each gap-free segment (no splitting), e.g. to reproduce a global fit.
   bool single_window = false;
   /// Find isolated defects before fitting (docs/velocity.md, "Jumps and glitches"): a sample
