@@ -108,12 +108,8 @@ CurveWindow SideWindow(const Eigen::VectorXd& t, const SideFit& fit, const Bridg
   window.series.coefficients = Eigen::MatrixXd::Zero(top + 1, d);
   for (Eigen::Index c = 0; c < d; ++c) {
     const int n = bridge.degrees[static_cast<size_t>(c)];
-    const Eigen::VectorXd points = ChebyshevPoints(n, window.series.interval);
-    Eigen::MatrixXd values(n + 1, 1);
-    for (int k = 0; k <= n; ++k) {
-      values(k, 0) = Clenshaw(fit.coefficients.col(c).head(n + 1), fit.interval.ToUnit(points[k]))[0];
-    }
-    window.series.coefficients.col(c).head(n + 1) = ValuesToCoefficients(values);
+    window.series.coefficients.col(c).head(n + 1) =
+        Reexpand(fit.coefficients.col(c).head(n + 1), fit.interval, window.series.interval);
   }
   window.coefficient_magnitudes = window.series.coefficients.cwiseAbs();
   window.first_derivative = DerivativeCoefficients(window.series.coefficients);

@@ -165,6 +165,15 @@ Eigen::RowVectorXd Clenshaw(const Eigen::Ref<const Eigen::MatrixXd>& coefficient
   return x * b1 - b2 + coefficients.row(0);
 }
 
+Eigen::MatrixXd Reexpand(const Eigen::Ref<const Eigen::MatrixXd>& coefficients, const Interval& from, const Interval& to) {
+  const auto n = static_cast<int>(coefficients.rows()) - 1;
+  if (n <= 0) return coefficients;
+  const Eigen::VectorXd points = ChebyshevPoints(n, to);
+  Eigen::MatrixXd values(n + 1, coefficients.cols());
+  for (int k = 0; k <= n; ++k) values.row(k) = Clenshaw(coefficients, from.ToUnit(points[k]));
+  return ValuesToCoefficients(values);
+}
+
 Eigen::MatrixXd DerivativeCoefficients(const Eigen::Ref<const Eigen::MatrixXd>& coefficients) {
   const Eigen::Index n = coefficients.rows() - 1;
   Eigen::MatrixXd d = Eigen::MatrixXd::Zero(coefficients.rows(), coefficients.cols());

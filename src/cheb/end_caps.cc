@@ -320,16 +320,7 @@ CurveWindow BuildCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::
     // The end window's own polynomial, re-expanded exactly on the cap's interval.
     const int n = end.degrees[c];
     cap.degrees.push_back(n);
-    if (n == 0) {
-      columns[c] = end.series.coefficients.block(0, c, 1, 1);
-      continue;
-    }
-    const Eigen::VectorXd points = ChebyshevPoints(n, cap.series.interval);
-    Eigen::MatrixXd values(n + 1, 1);
-    for (int k = 0; k <= n; ++k) {
-      values(k, 0) = Clenshaw(end.series.coefficients.col(c).head(n + 1), end.series.interval.ToUnit(points[k]))[0];
-    }
-    columns[c] = ValuesToCoefficients(values);
+    columns[c] = Reexpand(end.series.coefficients.col(c).head(n + 1), end.series.interval, cap.series.interval);
   }
   const int rows = *std::max_element(cap.degrees.begin(), cap.degrees.end()) + 1;
   cap.series.coefficients = Eigen::MatrixXd::Zero(rows, d);

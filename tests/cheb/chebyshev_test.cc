@@ -102,6 +102,26 @@ TEST(Interpolation, ClenshawAgreesWithBarycentricAndDerivatives) {
   }
 }
 
+// Re-expanded on a sub-interval (as a cap keeps an end window's polynomial), the same polynomials:
+// equal values anywhere inside it, and on their own interval the same coefficients.
+TEST(Reexpand, KeepsThePolynomialsOnASubInterval) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const Interval from{2.0, 7.0}, to{5.5, 6.25};
+  for (const int n : {0, 1, 5, 17}) {
+    Eigen::MatrixXd coefficients(n + 1, 2);
+    for (Eigen::Index k = 0; k <= n; ++k) coefficients.row(k) << unit(rng), unit(rng) / (1.0 + k);
+    const Eigen::MatrixXd there = Reexpand(coefficients, from, to);
+    ASSERT_EQ(there.rows(), n + 1);
+    for (int i = 0; i < 20; ++i) {
+      const double t = 5.5 + 0.75 * (0.5 + 0.5 * unit(rng));
+      const Eigen::RowVectorXd a = Clenshaw(coefficients, from.ToUnit(t)), b = Clenshaw(there, to.ToUnit(t));
+      EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 1e-13) << "degree " << n << " at " << t;
+    }
+    EXPECT_LT((Reexpand(coefficients, from, from) - coefficients).cwiseAbs().maxCoeff(), 1e-14) << "degree " << n;
+  }
+}
+
 TEST(Interpolation, ExactNodeHitsAtHighDegree) {
   for (int n : {256, 1024, 2000}) {
     const ChebyshevBasis basis(n);

@@ -87,6 +87,12 @@ Eigen::MatrixXd CoefficientsToValues(const Eigen::Ref<const Eigen::MatrixXd>& co
 /// Σ_k c_k T_k(x) for each column of `coefficients` by Clenshaw's recurrence (stable, O(N)).
 Eigen::RowVectorXd Clenshaw(const Eigen::Ref<const Eigen::MatrixXd>& coefficients, double x);
 
+/// The same polynomials on another interval: the coefficients on `to` (rows k = 0..N, a column per
+/// polynomial) of those whose coefficients on `from` are `coefficients`, exactly (their values at
+/// the N + 1 Chebyshev points of `to`). Outside `from` the polynomials are extrapolated, and their
+/// coefficients can grow by orders of magnitude over their values.
+Eigen::MatrixXd Reexpand(const Eigen::Ref<const Eigen::MatrixXd>& coefficients, const Interval& from, const Interval& to);
+
 /// Coefficients of the derivative d/dx of Σ c_k T_k (same number of rows; the last is 0), by the
 /// recurrence c'_{k-1} = c'_{k+1} + 2k c_k (with c'_0 halved).
 Eigen::MatrixXd DerivativeCoefficients(const Eigen::Ref<const Eigen::MatrixXd>& coefficients);
