@@ -152,11 +152,8 @@ std::optional<GapFit> FitGap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z,
                                                      std::floor(std::sqrt(kMaxConditioning * static_cast<double>(fit.count))),
                                                      static_cast<double>(fit.count / 2 - 1)}));
   if (top < 1) return std::nullopt;
-  fit.sigma = noise.Over(fit.first, fit.count);
-  for (Eigen::Index c = 0; c < z.cols(); ++c) {
-    fit.sigma[c] = std::max({fit.sigma[c], rounding[c],
-                             1e-9 * (1.0 + z.col(c).segment(fit.first, fit.count).cwiseAbs().maxCoeff())});
-  }
+  // As a window's (WindowSigma), and at least the values' rounding level.
+  fit.sigma = WindowSigma(noise.Over(fit.first, fit.count), z.middleRows(fit.first, fit.count)).cwiseMax(rounding);
   try {
     fit.bridge = FitBridge(t, z, fit.first, fit.count, interval, top, fit.sigma);
     if (!fit.bridge.passes) return std::nullopt;

@@ -62,6 +62,7 @@ using internal::kLackOfFitLimit;
 using internal::kMaxGramCondition;
 using internal::kNoiseMargin;
 using internal::LackOfFitScore;
+using internal::WindowSigma;
 
 // Fits one window and, for automatic degrees, says whether it should be split instead.
 class WindowFitter {
@@ -296,20 +297,6 @@ class WindowFitter {
       if (high > kHeldOutFloor * spread && high < (1.0 - 1e-9) * low) return true;
     }
     return false;
-  }
-
-  // The noise σ per coordinate a window's samples `z` are tested against: the noise profile's over
-  // them (`level`), floored at a rounding level of the values (1e-9 of their magnitude) so that
-  // exact data do not ask for an exact fit. Not the window's own estimate: a short window's
-  // scatters by tens of per cent, and taking the larger would let small unresolved motion pass as
-  // noise; the profile pools 160 samples and departs from the data's level only by a factor that
-  // scatter does not reach (internal::NoiseProfile).
-  static Eigen::VectorXd WindowSigma(const Eigen::VectorXd& level, const Eigen::Ref<const Eigen::MatrixXd>& z) {
-    Eigen::VectorXd sigma(z.cols());
-    for (Eigen::Index c = 0; c < z.cols(); ++c) {
-      sigma[c] = std::max(level[c], 1e-9 * (1.0 + z.col(c).cwiseAbs().maxCoeff()));
-    }
-    return sigma;
   }
 
   // Residuals of a window's series at its samples: fills residual_rms and lack_of_fit; whether

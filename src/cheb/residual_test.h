@@ -2,6 +2,7 @@
 // Internal to the cheb library: the residual test of a fitted window (curve.cc) and of a fit across
 // a gap (bridges.cc), docs/velocity.md "Residual test".
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Core>
@@ -18,6 +19,20 @@ inline constexpr double kLackOfFitLimit = 3.0;
 // hundreds of samples a χ² test alone would take for unresolved motion (it made the drone's body
 // rate 2–3x worse); a residual of 1.5σ (a missed tremor) still fails.
 inline constexpr double kNoiseMargin = 1.1;
+
+// The noise σ per coordinate a window's samples `z` are tested against: the noise profile's over
+// them (`level`), floored at a rounding level of the values (1e-9 of their magnitude) so that
+// exact data do not ask for an exact fit. Not the window's own estimate: a short window's
+// scatters by tens of per cent, and taking the larger would let small unresolved motion pass as
+// noise; the profile pools 160 samples and departs from the data's level only by a factor that
+// scatter does not reach (NoiseProfile).
+inline Eigen::VectorXd WindowSigma(const Eigen::VectorXd& level, const Eigen::Ref<const Eigen::MatrixXd>& z) {
+  Eigen::VectorXd sigma(z.cols());
+  for (Eigen::Index c = 0; c < z.cols(); ++c) {
+    sigma[c] = std::max(level[c], 1e-9 * (1.0 + z.col(c).cwiseAbs().maxCoeff()));
+  }
+  return sigma;
+}
 
 // Standard normal score of RSS/σ² against χ² with `dof` degrees of freedom (Wilson–Hilferty:
 // (X/ν)^(1/3) is nearly normal with mean 1 − 2/(9ν) and variance 2/(9ν)); 0 without freedom.
