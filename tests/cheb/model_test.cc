@@ -243,6 +243,24 @@ TEST(Compress, NoiseFreeMotionIsReconstructedToNanometres) {
   }
 }
 
+// A short noisy recording (1 s of hand-held motion at 100 Hz under 0.5 mm, seeds 1–4) is one window,
+// and its model stores that window alone: the end caps that serve the velocity of such a recording
+// ("End caps", short segments) would store its positions in 2.5x the numbers for the same error.
+TEST(Compress, AShortRecordingIsOneWindow) {
+  for (uint64_t seed = 1; seed <= 4; ++seed) {
+    sim::MotionOptions motion;
+    motion.kind = sim::MotionKind::kHandheld;
+    motion.seed = seed;
+    motion.duration_s = 1.0;
+    sim::MeasurementOptions measurement;
+    measurement.noise_m = 5e-4;
+    const Samples s = FromTrajectory(sim::Measure(sim::MotionModel(motion), measurement));
+    const Compression c = Compress(s.stamps, s.positions);
+    ASSERT_EQ(c.model.segments.size(), 1u);
+    EXPECT_EQ(c.model.segments[0].windows.size(), 1u) << "seed " << seed;
+  }
+}
+
 TEST(Compress, ToleranceIsMetAndSpentWhenAchievable) {
   const Samples s = Drone(30.0, 0.0005);
   const Compression automatic = Compress(s.stamps, s.positions);

@@ -21,13 +21,16 @@ struct CompressOptions {
   /// max_degree, min_window_samples, overlap); the defaults need no tuning. A model represents
   /// every sample: no sample is left out as an outlier, windows are judged by their coefficients
   /// (the residual test would store more than the samples of nearly noise-free ground truth), and
-  /// they stop at 24 samples (velocity's 12 serve its σ → 0 limit).
+  /// they stop at 24 samples (velocity's 12 serve its σ → 0 limit). A recording of one or two
+  /// windows gets no end caps: they serve its velocity, and would store its positions in 2.5x the
+  /// numbers.
   CurveOptions curve = CompressionCurveOptions();
   static CurveOptions CompressionCurveOptions() {
     CurveOptions options;
     options.robust = false;
     options.lack_of_fit = false;
     options.min_window_samples = 24;
+    options.short_segment_caps = false;
     return options;
   }
   /// The largest reconstruction error accepted (units of the samples: metres for positions): the
