@@ -1487,14 +1487,8 @@ void Curve::EvaluateMany(std::span<const int64_t> stamps_ns, int order, Eigen::M
         Eigen::Index end = begin + 1;
         while (end < count && (use_right ? placements[end].right : placements[end].left) == w) ++end;
         if (w != nullptr) {
-          Eigen::VectorXd x(end - begin);
-          for (Eigen::Index r = begin; r < end; ++r) x[r - begin] = w->series.interval.ToUnit(t[r]);
-          const double scale = w->series.interval.DerivativeScale();
-          out[0].middleRows(begin, end - begin) = EvaluateSeries(w->series.coefficients, x);
-          if (order >= 1) out[1].middleRows(begin, end - begin) = EvaluateSeries(w->first_derivative, x) * scale;
-          if (order >= 2) {
-            out[2].middleRows(begin, end - begin) = EvaluateSeries(w->second_derivative, x) * (scale * scale);
-          }
+          const Eigen::Map<const Eigen::VectorXd> times(t.data() + begin, end - begin);
+          for (int k = 0; k <= order; ++k) out[k].middleRows(begin, end - begin) = internal::WindowSeriesAt(*w, times, k);
         }
         begin = end;
       }

@@ -70,19 +70,11 @@ class OneSidedFits {
                     : SmallNormalEquations(block, m, top)),
         cholesky_(normal_, top),
         derivative_basis_(count, top + 1) {
-    // d/dτ T_k(x(τ)) = k U_{k-1}(x) · dx/dτ, U the Chebyshev polynomials of the second kind.
     const Interval interval{0.0, block.tau[m - 1]};
-    const double scale = interval.DerivativeScale();
+    Eigen::VectorXd slopes(top + 1);
     for (Eigen::Index j = 0; j < count; ++j) {
-      const double x = interval.ToUnit(block.tau[j]);
-      double u_previous = 0.0, u = 1.0;  // U_{k-2}, U_{k-1}
-      derivative_basis_(j, 0) = 0.0;
-      for (int k = 1; k <= top; ++k) {
-        derivative_basis_(j, k) = k * u * scale;
-        const double next = 2.0 * x * u - u_previous;
-        u_previous = u;
-        u = next;
-      }
+      ChebyshevSlopes(interval.ToUnit(block.tau[j]), interval.DerivativeScale(), slopes);
+      derivative_basis_.row(j) = slopes.transpose();
     }
   }
 
@@ -331,24 +323,21 @@ CurveWindow BuildCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::
   return cap;
 }
 
-// The rate of `window` at samples first .. first + count - 1.
-Eigen::MatrixXd WindowRate(const Eigen::VectorXd& t, const CurveWindow& window, Eigen::Index first, Eigen::Index count) {
-  const Interval& interval = window.series.interval;
-  Eigen::VectorXd x(count);
-  for (Eigen::Index i = 0; i < count; ++i) x[i] = interval.ToUnit(t[first + i]);
-  return EvaluateSeries(window.first_derivative, x) * interval.DerivativeScale();
+// The factor of `window`'s normal matrix up to its highest degree; none where its samples no
+// longer determine it (repeated stamps).
+std::optional<NestedCholesky> FactorAtTop(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const CurveWindow& window) {
+  return FactorWindow(t, z, window, *std::max_element(window.degrees.begin(), window.degrees.end()));
 }
 
 // The variance of `window`'s rate at `count` samples from `at` on in direction `step` (±1), per
-// coordinate: σ²·dᵀG⁻¹d with the window's σ; none where its samples no longer determine it.
-std::optional<Eigen::MatrixXd> RateVariance(const Eigen::VectorXd& t, const Eigen::MatrixXd& z,
-                                            const CurveWindow& window, Eigen::Index at, int step, Eigen::Index count) {
-  const std::optional<NestedCholesky> cholesky =
-      FactorWindow(t, z, window, *std::max_element(window.degrees.begin(), window.degrees.end()));
-  if (!cholesky || window.noise_sigma.size() != z.cols()) return std::nullopt;
-  Eigen::MatrixXd variance(count, z.cols());
+// coordinate: σ²·dᵀG⁻¹d with the window's σ (`cholesky` its FactorAtTop); none without that σ.
+std::optional<Eigen::MatrixXd> RateVariance(const Eigen::VectorXd& t, const CurveWindow& window,
+                                            const NestedCholesky& cholesky, Eigen::Index at, int step, Eigen::Index count) {
+  const auto d = static_cast<Eigen::Index>(window.degrees.size());
+  if (window.noise_sigma.size() != d) return std::nullopt;
+  Eigen::MatrixXd variance(count, d);
   for (Eigen::Index o = 0; o < count; ++o) {
-    variance.row(o) = RateVarianceFactor(*cholesky, window.series.interval, window.degrees, t[at + step * o])
+    variance.row(o) = RateVarianceFactor(cholesky, window.series.interval, window.degrees, t[at + step * o])
                           .cwiseProduct(window.noise_sigma.cwiseAbs2())
                           .transpose();
   }
@@ -374,6 +363,12 @@ void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloci
   const ArtificialEnds interior{std::upper_bound(begin, end, windows.front().fit_end) - t.data(),
                                 std::lower_bound(begin, end, windows.back().fit_begin) - t.data(), 0, 0};
   if (!spanned && interior.hi <= interior.lo) return;
+  // The end windows' factors: one when the segment is one window, whose two ends share it.
+  std::array<std::optional<NestedCholesky>, 2> factors;
+  if (spanned) {
+    ParallelFor(static_cast<int>(windows.size()), threads,
+                [&](int k) { factors[static_cast<size_t>(k)] = FactorAtTop(t, z, k == 0 ? windows.front() : windows.back()); });
+  }
   std::array<Choice, 2> choices;
   ParallelFor(2, threads, [&](int side) {
     const bool front = side == 0;
@@ -388,14 +383,16 @@ void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloci
     }
     // The end window's rate at the real end's samples, and its variance there.
     const Eigen::Index offsets = std::min(end_samples / 2, BlendEnd(kCapBoundaries.back()));
+    const std::optional<NestedCholesky>& factor = factors[windows.size() == 1 ? 0 : static_cast<size_t>(side)];
+    if (!factor) return;  // its samples no longer determine the window (repeated stamps)
     const std::optional<Eigen::MatrixXd> end_variance =
-        RateVariance(t, z, w, front ? first : last - 1, front ? 1 : -1, offsets);
-    if (!end_variance) return;  // its samples no longer determine the window (repeated stamps)
+        RateVariance(t, w, *factor, front ? first : last - 1, front ? 1 : -1, offsets);
+    if (!end_variance) return;
     const Eigen::Index wf = std::lower_bound(begin, end, w.fit_begin) - t.data(), wl = wf + end_samples;
     const ArtificialEnds ends{wf + end_samples / 4, wl - end_samples / 4, wf, wl};
     if (ends.hi <= ends.lo) return;
     const VelocityAt own_velocity = [&](Eigen::Index from, Eigen::Index count) {
-      return WindowRate(t, w, from, count);
+      return WindowSeriesAt(w, t.segment(from, count), 1);
     };
     choices[static_cast<size_t>(side)] = ChooseCap(t, z, own_velocity, ends, end_samples, w, end_samples,
                                                    core_samples, shortest, &*end_variance);

@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <stdexcept>
 #include <vector>
 
 #include "cheval/cheb/fit.h"
@@ -145,6 +146,19 @@ std::optional<NestedCholesky> FactorWindow(const Eigen::VectorXd& t, const Eigen
                           degree);
   } catch (const ComputeError&) {
     return std::nullopt;
+  }
+}
+
+Eigen::MatrixXd WindowSeriesAt(const CurveWindow& window, const Eigen::Ref<const Eigen::VectorXd>& times, int order) {
+  const Interval& interval = window.series.interval;
+  Eigen::VectorXd x(times.size());
+  for (Eigen::Index i = 0; i < times.size(); ++i) x[i] = interval.ToUnit(times[i]);
+  const double scale = interval.DerivativeScale();
+  switch (order) {
+    case 0: return EvaluateSeries(window.series.coefficients, x);
+    case 1: return EvaluateSeries(window.first_derivative, x) * scale;
+    case 2: return EvaluateSeries(window.second_derivative, x) * (scale * scale);
+    default: throw std::invalid_argument("WindowSeriesAt: order 0..2");
   }
 }
 

@@ -25,6 +25,9 @@ std::vector<Eigen::Index> SampleWindows(const Eigen::VectorXd& t, Eigen::Index f
 std::optional<NestedCholesky> FactorWindow(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const CurveWindow& window,
                                            int degree);
 
+/// `window`'s values (order 0), rates (1) or second derivatives (2) at `times` (s), one row per time.
+Eigen::MatrixXd WindowSeriesAt(const CurveWindow& window, const Eigen::Ref<const Eigen::VectorXd>& times, int order);
+
 /// `scale`·T'_k(x) = `scale`·k·U_{k−1}(x) for k = 0 .. slopes.size() − 1: the Chebyshev polynomials'
 /// derivatives at x in [−1, 1], by the U recurrence (`scale` the interval's DerivativeScale gives d/dt).
 void ChebyshevSlopes(double x, double scale, Eigen::Ref<Eigen::VectorXd> slopes);

@@ -3,12 +3,15 @@
 // around it; a displaced sample has both of its slopes left out and takes the secant across it.
 #include <cmath>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "local_rates.h"
 #include "noise_profile.h"
+
+#include "cheval/cheb/chebyshev.h"
 
 namespace cheval::cheb::internal {
 namespace {
@@ -108,6 +111,28 @@ TEST(LocalRates, OnlyNoisyLocalSamplesAreCalledNoisy) {
   EXPECT_TRUE(noisy(kNoise, kNoise, kNoise));
   EXPECT_FALSE(noisy(kNoise, 0.0, kNoise / 10.0));
   EXPECT_FALSE(noisy(10.0 * kNoise, 0.0, kNoise));
+}
+
+// A window's values, rates and second derivatives at times on its interval: those of the
+// polynomial its series holds, p(t) = 2 − t + t³/2 on [1, 3], whose Chebyshev coefficients in
+// x = t − 2 are 5.5, 5.375, 1.5 and 0.125.
+TEST(WindowSeriesAt, GivesThePolynomialAndItsDerivatives) {
+  CurveWindow window;
+  window.series.interval = {1.0, 3.0};
+  window.series.coefficients = Eigen::Vector4d(5.5, 5.375, 1.5, 0.125);
+  window.first_derivative = DerivativeCoefficients(window.series.coefficients);
+  window.second_derivative = DerivativeCoefficients(window.first_derivative);
+  const Eigen::Vector3d times(1.0, 1.7, 3.0);
+  const Eigen::MatrixXd values = WindowSeriesAt(window, times, 0), rates = WindowSeriesAt(window, times, 1),
+                        second = WindowSeriesAt(window, times, 2);
+  ASSERT_EQ(values.rows(), 3);
+  for (Eigen::Index i = 0; i < times.size(); ++i) {
+    const double t = times[i];
+    EXPECT_NEAR(values(i, 0), 2.0 - t + 0.5 * t * t * t, 1e-13) << t;
+    EXPECT_NEAR(rates(i, 0), -1.0 + 1.5 * t * t, 1e-13) << t;
+    EXPECT_NEAR(second(i, 0), 3.0 * t, 1e-13) << t;
+  }
+  EXPECT_THROW(WindowSeriesAt(window, times, 3), std::invalid_argument);
 }
 
 }  // namespace
