@@ -31,24 +31,27 @@ constexpr double kTrendLimit = 3.0;
 constexpr double kMaxConditioning = 8.0;
 
 // A least-squares fit of samples [first, first + count) with a degree per coordinate, and the
-// variance factor dᵀG⁻¹d of its rate at one time per coordinate (d the derivative's basis there:
-// times σ², the rate's variance).
-struct SideFit {
+// factor of its normal matrix up to the highest of them.
+struct SampleFit {
   Interval interval;
+  std::vector<int> degrees;
   Eigen::MatrixXd coefficients;  // (top + 1) x d, zero above each coordinate's degree
-  Eigen::VectorXd rate_variance_factor;
+  NestedCholesky cholesky;
+
+  // The variance factor dᵀG⁻¹d of the rate at time `at` per coordinate (d the derivative's basis
+  // there): times σ², the rate's variance.
+  Eigen::VectorXd RateVarianceFactorAt(double at) const { return RateVarianceFactor(cholesky, interval, degrees, at); }
 };
 
-SideFit FitAt(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index count,
-              const Interval& interval, const std::vector<int>& degrees, double at) {
+SampleFit FitSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index count,
+                     const Interval& interval, const std::vector<int>& degrees) {
   const Eigen::Index d = z.cols();
   const int top = *std::max_element(degrees.begin(), degrees.end());
   const NormalEquations normal = BuildNormalEquations(t.segment(first, count), z.middleRows(first, count), top, interval);
-  const NestedCholesky cholesky(normal, top);
-  SideFit fit{interval, Eigen::MatrixXd::Zero(top + 1, d), RateVarianceFactor(cholesky, interval, degrees, at)};
+  SampleFit fit{interval, degrees, Eigen::MatrixXd::Zero(top + 1, d), NestedCholesky(normal, top)};
   for (Eigen::Index c = 0; c < d; ++c) {
     const int n = degrees[static_cast<size_t>(c)];
-    fit.coefficients.col(c).head(n + 1) = cholesky.Solve(n, normal.rhs.col(c));
+    fit.coefficients.col(c).head(n + 1) = fit.cholesky.Solve(n, normal.rhs.col(c));
   }
   return fit;
 }
@@ -95,7 +98,7 @@ Bridge FitBridge(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Inde
 
 // The window of a side: the bridge's polynomial re-expanded exactly on a segment's samples
 // [first, first + count) (inside the bridge's interval: no extrapolation).
-CurveWindow SideWindow(const Eigen::VectorXd& t, const SideFit& fit, const Bridge& bridge, Eigen::Index first,
+CurveWindow SideWindow(const Eigen::VectorXd& t, const SampleFit& fit, const Bridge& bridge, Eigen::Index first,
                        Eigen::Index count, const Eigen::VectorXd& sigma) {
   const Eigen::Index d = fit.coefficients.cols();
   CurveWindow window;
@@ -121,13 +124,16 @@ CurveWindow SideWindow(const Eigen::VectorXd& t, const SideFit& fit, const Bridg
   return window;
 }
 
-// A gap's fit and its two sides: the back of the segment before (side 0) and the front of the
-// one after (side 1).
+// A gap's fit, which serves its two sides: the back of the segment before (side 0) and the front
+// of the one after (side 1).
 struct GapFit {
   Bridge bridge;
   Eigen::Index first = 0, count = 0, gap = 0;  // the fit's samples; the first sample after the gap
   Eigen::VectorXd sigma;
-  std::array<SideFit, 2> sides;
+  std::optional<SampleFit> across;  // the fit at the bridge's degrees
+  // Its rate's variance factors beside the gap: at the last sample before it (side 0) and the
+  // first after it (side 1).
+  std::array<Eigen::VectorXd, 2> beside;
 };
 
 // Fits across the gap before sample `gap` the samples within `reach` of it, across further gaps
@@ -157,8 +163,8 @@ std::optional<GapFit> FitGap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z,
   try {
     fit.bridge = FitBridge(t, z, fit.first, fit.count, interval, top, fit.sigma);
     if (!fit.bridge.passes) return std::nullopt;
-    fit.sides[0] = FitAt(t, z, fit.first, fit.count, interval, fit.bridge.degrees, t[gap - 1]);
-    fit.sides[1] = FitAt(t, z, fit.first, fit.count, interval, fit.bridge.degrees, t[gap]);
+    fit.across = FitSamples(t, z, fit.first, fit.count, interval, fit.bridge.degrees);
+    fit.beside = {fit.across->RateVarianceFactorAt(t[gap - 1]), fit.across->RateVarianceFactorAt(t[gap])};
   } catch (const ComputeError&) {
     return std::nullopt;  // repeated stamps: the samples do not determine the fit
   }
@@ -171,7 +177,7 @@ std::optional<GapFit> FitGap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z,
 // Under noise the slope is the noise's; on nearly noise-free data it is the bias of a fit held to
 // a hole's low degree, which the segment's own end (then exact) does not have.
 bool ResidualTrendIsNoise(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index count,
-                          const SideFit& fit, const Eigen::VectorXd& sigma) {
+                          const SampleFit& fit, const Eigen::VectorXd& sigma) {
   const auto tw = t.segment(first, count);
   Eigen::VectorXd x(count);
   for (Eigen::Index i = 0; i < count; ++i) x[i] = fit.interval.ToUnit(tw[i]);
@@ -204,21 +210,15 @@ std::optional<Eigen::VectorXd> OwnVarianceFactor(const Eigen::VectorXd& t, const
 bool SideHelps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const GapFit& gap, bool back, Eigen::Index begin,
                Eigen::Index end, const CurveSegment& segment, Eigen::Index from, Eigen::Index count,
                const GapFit* incumbent = nullptr) {
-  const SideFit& fit = gap.sides[back ? 0 : 1];
+  const SampleFit& fit = *gap.across;
   const Eigen::VectorXd variance = gap.sigma.cwiseAbs2();
   const bool whole = from == begin && count == end - begin;
   for (const Eigen::Index at : {back ? end - 1 : begin, back ? begin : end - 1}) {
     // An end window its samples do not determine again (fewer distinct stamps than its degree
     // asks for: a few samples between dropouts) is no rival.
-    const std::optional<Eigen::VectorXd> own =
-        incumbent != nullptr ? FitAt(t, z, incumbent->first, incumbent->count, incumbent->sides[0].interval,
-                                     incumbent->bridge.degrees, t[at])
-                                   .rate_variance_factor
-                             : OwnVarianceFactor(t, z, end, segment, at);
-    const Eigen::VectorXd factor =
-        at == (back ? end - 1 : begin)
-            ? fit.rate_variance_factor
-            : FitAt(t, z, gap.first, gap.count, fit.interval, gap.bridge.degrees, t[at]).rate_variance_factor;
+    const std::optional<Eigen::VectorXd> own = incumbent != nullptr ? incumbent->across->RateVarianceFactorAt(t[at])
+                                                                    : OwnVarianceFactor(t, z, end, segment, at);
+    const Eigen::VectorXd factor = at == (back ? end - 1 : begin) ? gap.beside[back ? 0 : 1] : fit.RateVarianceFactorAt(t[at]);
     if (own && !(factor.dot(variance) < own->dot(variance))) return false;
     if (!whole) break;
   }
@@ -238,7 +238,7 @@ std::pair<Eigen::Index, Eigen::Index> SideSamples(const GapFit& gap, bool back, 
 // The window of a gap's side over the samples of the segment [begin, end) it covers.
 CurveWindow SideWindow(const Eigen::VectorXd& t, const GapFit& gap, bool back, Eigen::Index begin, Eigen::Index end) {
   const auto [from, count] = SideSamples(gap, back, begin, end);
-  return SideWindow(t, gap.sides[back ? 0 : 1], gap.bridge, from, count, gap.sigma);
+  return SideWindow(t, *gap.across, gap.bridge, from, count, gap.sigma);
 }
 
 // Puts `bridge` at the back (or front) of a segment, from `boundary` on (up to it): windows whose
@@ -292,7 +292,7 @@ void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
       if (!fit) continue;
       const Eigen::VectorXd variance = fit->sigma.cwiseAbs2();
       const double spread =
-          variance.dot(fit->sides[0].rate_variance_factor) + variance.dot(fit->sides[1].rate_variance_factor);
+          variance.dot(fit->beside[0]) + variance.dot(fit->beside[1]);
       const bool same = fits[k] && fits[k]->first == fit->first && fits[k]->count == fit->count;
       if (spread < least && !same) least = spread, fits[k] = std::move(fit);
     }
@@ -328,7 +328,7 @@ void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
       const GapFit* gap = at_back ? back : front;
       if (gap == nullptr || (at_back ? back_whole : front_whole)) continue;
       if ((at_back ? back_covers : front_covers) &&
-          !ResidualTrendIsNoise(t, z, begin, n, gap->sides[at_back ? 0 : 1], gap->sigma)) {
+          !ResidualTrendIsNoise(t, z, begin, n, *gap->across, gap->sigma)) {
         continue;
       }
       const Eigen::Index side = SideSamples(*gap, at_back, begin, end).second;
