@@ -171,25 +171,29 @@ std::optional<GapFit> FitGap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z,
   return fit;
 }
 
-// Whether the residuals of a side's fit over samples [first, first + count) (those where it takes
-// over) show no trend: the slope of their least-squares line is its rate's bias averaged there,
-// and it must stay within kTrendLimit standard deviations (σ/sqrt(Σ(t − t̄)²)) in every coordinate.
-// Under noise the slope is the noise's; on nearly noise-free data it is the bias of a fit held to
-// a hole's low degree, which the segment's own end (then exact) does not have.
-bool ResidualTrendIsNoise(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index count,
-                          const SampleFit& fit, const Eigen::VectorXd& sigma) {
+// The slopes of the least-squares lines through the residuals of a side's fit over samples
+// [first, first + count) (those where it takes over), per coordinate: its rate's bias averaged
+// there plus the noise's slope, whose standard deviation is σ/sqrt(Σ(t − t̄)²). Under noise the
+// slope is mostly the noise's; on nearly noise-free data it is the bias of a fit held to a hole's
+// low degree, which the segment's own end (then exact) does not have.
+struct ResidualTrend {
+  Eigen::VectorXd slope, deviation;
+
+  // Whether the slope is within kTrendLimit standard deviations in every coordinate.
+  bool IsNoise() const { return (slope.array().abs() <= kTrendLimit * deviation.array()).all(); }
+};
+
+// None where the samples share one stamp.
+std::optional<ResidualTrend> TrendOf(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
+                                     Eigen::Index count, const SampleFit& fit, const Eigen::VectorXd& sigma) {
   const auto tw = t.segment(first, count);
   Eigen::VectorXd x(count);
   for (Eigen::Index i = 0; i < count; ++i) x[i] = fit.interval.ToUnit(tw[i]);
   const Eigen::MatrixXd residual = z.middleRows(first, count) - EvaluateSeries(fit.coefficients, x);
   const Eigen::VectorXd centred = tw.array() - tw.mean();
   const double spread = centred.squaredNorm();
-  if (!(spread > 0.0)) return false;
-  for (Eigen::Index c = 0; c < z.cols(); ++c) {
-    const double slope = centred.dot(residual.col(c)) / spread;
-    if (!(std::abs(slope) <= kTrendLimit * sigma[c] / std::sqrt(spread))) return false;
-  }
-  return true;
+  if (!(spread > 0.0)) return std::nullopt;
+  return ResidualTrend{residual.transpose() * centred / spread, sigma / std::sqrt(spread)};
 }
 
 // The rate's variance factor of the segment [begin, end)'s own fit at its sample `at`: that of the
@@ -206,23 +210,31 @@ std::optional<Eigen::VectorXd> OwnVarianceFactor(const Eigen::VectorXd& t, const
 // Whether a gap's side may stand in for the segment [begin, end) it borders (`back`: at the
 // segment's back) over its samples [from, from + count): its rate has the smaller variance than
 // the segment's own at the sample beside the gap (and, for a whole segment, at its other end too),
-// and its residuals there show no trend.
+// and its residuals there show no trend. A trend above the noise is taken as a bias of the side's
+// rate, all of it (the noise's share is not known): the side still helps where that bias squared
+// and its rate's variance together stay below the segment's own rate's variance (a few samples
+// between dropouts under noise, whose own rate is far noisier than 3 standard deviations of their
+// slope).
 bool SideHelps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const GapFit& gap, bool back, Eigen::Index begin,
                Eigen::Index end, const CurveSegment& segment, Eigen::Index from, Eigen::Index count,
                const GapFit* incumbent = nullptr) {
   const SampleFit& fit = *gap.across;
+  const std::optional<ResidualTrend> trend = TrendOf(t, z, from, count, fit, gap.sigma);
+  if (!trend) return false;
+  const double bias = trend->IsNoise() ? 0.0 : trend->slope.squaredNorm();
   const Eigen::VectorXd variance = gap.sigma.cwiseAbs2();
   const bool whole = from == begin && count == end - begin;
   for (const Eigen::Index at : {back ? end - 1 : begin, back ? begin : end - 1}) {
     // An end window its samples do not determine again (fewer distinct stamps than its degree
-    // asks for: a few samples between dropouts) is no rival.
+    // asks for: a few samples between dropouts) is no rival, but no measure of a bias either.
     const std::optional<Eigen::VectorXd> own = incumbent != nullptr ? incumbent->across->RateVarianceFactorAt(t[at])
                                                                     : OwnVarianceFactor(t, z, end, segment, at);
-    const Eigen::VectorXd factor = at == (back ? end - 1 : begin) ? gap.beside[back ? 0 : 1] : fit.RateVarianceFactorAt(t[at]);
-    if (own && !(factor.dot(variance) < own->dot(variance))) return false;
+    const Eigen::VectorXd factor =
+        at == (back ? end - 1 : begin) ? gap.beside[back ? 0 : 1] : fit.RateVarianceFactorAt(t[at]);
+    if (own ? !(factor.dot(variance) + bias < own->dot(variance)) : bias > 0.0) return false;
     if (!whole) break;
   }
-  return ResidualTrendIsNoise(t, z, from, count, fit, gap.sigma);
+  return true;
 }
 
 // The samples of the segment [begin, end) that a gap's fit covers on its side (`back`: the gap
@@ -291,8 +303,7 @@ void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
                                          reach * (t[gap] - t[gap - 1]), noise, rounding);
       if (!fit) continue;
       const Eigen::VectorXd variance = fit->sigma.cwiseAbs2();
-      const double spread =
-          variance.dot(fit->beside[0]) + variance.dot(fit->beside[1]);
+      const double spread = variance.dot(fit->beside[0]) + variance.dot(fit->beside[1]);
       const bool same = fits[k] && fits[k]->first == fit->first && fits[k]->count == fit->count;
       if (spread < least && !same) least = spread, fits[k] = std::move(fit);
     }
@@ -309,16 +320,19 @@ void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
     const bool front_whole = front_covers && SideHelps(t, z, *front, false, begin, end, segment, begin, n);
     const bool back_whole = back_covers && SideHelps(t, z, *back, true, begin, end, segment, begin, n);
     if (front_whole || back_whole) {
-      std::vector<CurveWindow> windows;
-      if (front_whole) windows.push_back(SideWindow(t, *front, false, begin, end));
-      if (back_whole) windows.push_back(SideWindow(t, *back, true, begin, end));
-      windows.front().core_begin = segment.windows.front().core_begin;
-      windows.back().core_end = segment.windows.back().core_end;
-      // The two meet half-way in time (each then blends over a quarter of the segment); a segment
-      // of one stamp has no middle, and keeps the first.
-      if (windows.size() == 2 && !(t[end - 1] > t[begin])) windows.pop_back();
-      if (windows.size() == 2) windows[0].core_end = windows[1].core_begin = 0.5 * (t[begin] + t[end - 1]);
-      segment.windows = std::move(windows);
+      // Where both help, the one whose rate has the smaller variance at the segment's two ends. Two
+      // meeting inside it would blend over a fraction of its span, and the difference between
+      // their positions, small as it is, would enter the rate divided by that fraction: between
+      // dropouts a tenth of a second apart, tens of mm/s under 2 mm of noise.
+      auto end_variance = [&](const GapFit& gap) {
+        const SampleFit& fit = *gap.across;
+        return gap.sigma.cwiseAbs2().dot(fit.RateVarianceFactorAt(t[begin]) + fit.RateVarianceFactorAt(t[end - 1]));
+      };
+      const bool keep_front = front_whole && (!back_whole || end_variance(*front) <= end_variance(*back));
+      CurveWindow window = SideWindow(t, keep_front ? *front : *back, !keep_front, begin, end);
+      window.core_begin = segment.windows.front().core_begin;
+      window.core_end = segment.windows.back().core_end;
+      segment.windows = {std::move(window)};
     }
     // Otherwise each end's own: alone over z/2 samples from the gap, blended up to 1.5z, z a third
     // of its side's samples and of the segment's (room for both ends' blends). Not a fit whose
@@ -327,9 +341,9 @@ void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
     for (const bool at_back : {true, false}) {
       const GapFit* gap = at_back ? back : front;
       if (gap == nullptr || (at_back ? back_whole : front_whole)) continue;
-      if ((at_back ? back_covers : front_covers) &&
-          !ResidualTrendIsNoise(t, z, begin, n, *gap->across, gap->sigma)) {
-        continue;
+      if (at_back ? back_covers : front_covers) {
+        const std::optional<ResidualTrend> trend = TrendOf(t, z, begin, n, *gap->across, gap->sigma);
+        if (!trend || !trend->IsNoise()) continue;
       }
       const Eigen::Index side = SideSamples(*gap, at_back, begin, end).second;
       const Eigen::Index zone = std::min(side - 1, n - 1) / 3;
