@@ -19,9 +19,15 @@ namespace cheval::cheb::internal {
 namespace {
 
 // The samples within this many gap lengths on either side of a gap are fitted across it: of the
-// reaches whose fits pass the residual test, the one whose rates beside the gap have the least
-// variance (the longest the motion allows, for it is smooth enough there).
-constexpr std::array<double, 3> kReaches{2.0, 4.0, 8.0};
+// reaches whose fits pass the residual test and agree (kAgreement), the one whose rates beside the
+// gap have the least variance (the longest the motion allows, for it is smooth enough there).
+constexpr std::array<double, 4> kReaches{2.0, 4.0, 8.0, 16.0};
+// The reaches' rates beside a gap agree while their intervals of this many standard deviations
+// share a point, on both sides and in every coordinate: the intersection of confidence intervals
+// (Goldenshluger & Nemirovski 1997). A longer reach buys its smaller variance with a bias that its
+// residual test, over many samples, may not show; beside the gap it puts the rate outside the
+// interval of a shorter reach, and the reaches stop there.
+constexpr double kAgreement = 3.0;
 // Each side of a gap keeps at least this many samples within reach to be fitted across it.
 constexpr Eigen::Index kMinSide = 4;
 // The slope of a fit's residuals where it takes over may reach this many of its standard deviations
@@ -41,6 +47,12 @@ struct SampleFit {
   // The variance factor dᵀG⁻¹d of the rate at time `at` per coordinate (d the derivative's basis
   // there): times σ², the rate's variance.
   Eigen::VectorXd RateVarianceFactorAt(double at) const { return RateVarianceFactor(cholesky, interval, degrees, at); }
+  // The rate at time `at` per coordinate.
+  Eigen::VectorXd RateAt(double at) const {
+    Eigen::VectorXd slopes(coefficients.rows());
+    ChebyshevSlopes(interval.ToUnit(at), interval.DerivativeScale(), slopes);
+    return coefficients.transpose() * slopes;
+  }
 };
 
 SampleFit FitSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index count,
@@ -134,6 +146,29 @@ struct GapFit {
   // Its rate's variance factors beside the gap: at the last sample before it (side 0) and the
   // first after it (side 1).
   std::array<Eigen::VectorXd, 2> beside;
+};
+
+// The intersection of the intervals of kAgreement standard deviations around the rates beside a
+// gap (rows: the last sample before it and the first after it; columns: coordinates) of the fits
+// across it admitted so far.
+class RateAgreement {
+ public:
+  explicit RateAgreement(Eigen::Index d)
+      : low_(Eigen::ArrayXXd::Constant(2, d, -std::numeric_limits<double>::infinity())), high_(-low_) {}
+
+  // Narrows the intersection by the intervals of `fit`: false when that leaves it empty.
+  bool Admit(const Eigen::VectorXd& t, const GapFit& fit) {
+    for (int side = 0; side < 2; ++side) {
+      const Eigen::ArrayXd rate = fit.across->RateAt(t[side == 0 ? fit.gap - 1 : fit.gap]).array();
+      const Eigen::ArrayXd deviation = fit.sigma.cwiseAbs2().cwiseProduct(fit.beside[side]).cwiseSqrt().array();
+      low_.row(side) = low_.row(side).max((rate - kAgreement * deviation).transpose());
+      high_.row(side) = high_.row(side).min((rate + kAgreement * deviation).transpose());
+    }
+    return (low_ <= high_).all();
+  }
+
+ private:
+  Eigen::ArrayXXd low_, high_;
 };
 
 // Fits across the gap before sample `gap` the samples within `reach` of it, across further gaps
@@ -298,10 +333,12 @@ void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
     if ((*segments)[k].continues) return;  // a jump, not a gap
     const Eigen::Index gap = starts[k + 1];
     double least = std::numeric_limits<double>::infinity();
+    RateAgreement agreement(z.cols());
     for (const double reach : kReaches) {
       std::optional<GapFit> fit = FitGap(t, z, starts[run_begin[k]], gap, starts[run_end[k + 1]],
                                          reach * (t[gap] - t[gap - 1]), noise, rounding);
       if (!fit) continue;
+      if (!agreement.Admit(t, *fit)) break;  // a longer reach would not agree either
       const Eigen::VectorXd variance = fit->sigma.cwiseAbs2();
       const double spread = variance.dot(fit->beside[0]) + variance.dot(fit->beside[1]);
       const bool same = fits[k] && fits[k]->first == fit->first && fits[k]->count == fit->count;

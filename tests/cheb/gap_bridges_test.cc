@@ -2,12 +2,13 @@
 // a dropout take the rate of a fit across it instead of a one-sided end's, and where noise-free
 // data take one it is exact. The first case failed before bridges existed: the rate was 1.58x
 // (0.5 mm) and 3.17x (2 mm) the best Savitzky–Golay filter's, whose windows reach across the gaps;
-// with them 0.43x and 0.46x.
+// with them 0.43x and 0.46x, now 0.38x and 0.54x.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include <Eigen/QR>
@@ -132,28 +133,34 @@ TEST(GapBridges, HoldTheRateAcrossDropoutsUnderNoise) {
   }
 }
 
-// Between many short dropouts (60 of 0.12 s in 20 s of motion up to 0.2 Hz, under 2 mm) most
-// segments are a few to a few dozen samples, and fits across their gaps take them over whole. Two
-// things kept that from working: a fit whose residuals over so few samples had a slope of just
-// over 3 of its standard deviations (noise, in one segment of a hundred) was refused, which left
-// that segment its own rate, hundreds of mm/s off; and where the fits across both its gaps took a
-// segment over, they met half-way and blended over a few samples, putting the difference of their
-// positions into the rate. Before: 6.13 mm/s against the best Savitzky–Golay window's 3.59; now 3.40.
+// Between many short dropouts (60 of 0.12 s in 20 s, under 2 mm) most segments are a few to a few
+// dozen samples, and fits across their gaps take them over whole. Two things kept that from
+// working: a fit whose residuals over so few samples had a slope of just over 3 of its standard
+// deviations (noise, in one segment of a hundred) was refused, which left that segment its own
+// rate, hundreds of mm/s off; and where the fits across both its gaps took a segment over, they met
+// half-way and blended over a few samples, putting the difference of their positions into the
+// rate. Motion up to 0.2 Hz was 6.13 mm/s against the best Savitzky–Golay window's 3.59; 3.40 with
+// both fixed, and 3.07 with reaches of 16 gap lengths. Slower motion (0.1 Hz), whose best window
+// spans more gaps than that, stays above the oracle: 3.81 against 1.75 before the longer reaches,
+// 2.57 with them; the bound below holds that gain.
 TEST(GapBridges, TakeOverTheShortSegmentsBetweenManyDropouts) {
-  double cheval = 0.0, oracle = 0.0;
-  int bridges = 0;
-  for (uint64_t seed = 1; seed <= 4; ++seed) {
-    const Recording r = Record(0.002, 60, seed, 0.12, 0.2);
-    const Curve curve = FitCurve(r.stamps, r.positions);
-    bridges += BridgeWindows(curve);
-    cheval += std::pow(RateError(curve, r, false), 2);
-    oracle += std::pow(BestSavitzkyGolay(r), 2);
+  for (const auto [f_max, bound] : {std::pair{0.2, 1.0}, std::pair{0.1, 1.6}}) {
+    double cheval = 0.0, oracle = 0.0;
+    int bridges = 0;
+    for (uint64_t seed = 1; seed <= 4; ++seed) {
+      const Recording r = Record(0.002, 60, seed, 0.12, f_max);
+      const Curve curve = FitCurve(r.stamps, r.positions);
+      bridges += BridgeWindows(curve);
+      cheval += std::pow(RateError(curve, r, false), 2);
+      oracle += std::pow(BestSavitzkyGolay(r), 2);
+    }
+    cheval = std::sqrt(cheval / 4), oracle = std::sqrt(oracle / 4);
+    SCOPED_TRACE(testing::Message() << "motion up to " << f_max << " Hz: " << cheval * 1e3
+                                    << " mm/s, best Savitzky-Golay " << oracle * 1e3 << ", " << bridges
+                                    << " bridge windows");
+    EXPECT_GT(bridges, 100);
+    EXPECT_LT(cheval, bound * oracle);
   }
-  cheval = std::sqrt(cheval / 4), oracle = std::sqrt(oracle / 4);
-  SCOPED_TRACE(testing::Message() << cheval * 1e3 << " mm/s, best Savitzky-Golay " << oracle * 1e3 << ", " << bridges
-                                  << " bridge windows");
-  EXPECT_GT(bridges, 100);
-  EXPECT_LT(cheval, oracle);
 }
 
 // A short segment between two gaps (two samples, or a few with repeated stamps) taken over whole
