@@ -1098,7 +1098,8 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   if (profile.stamp_noise()) curve.stamp_noise_s_ = std::sqrt(profile.stamp_noise()->variance);
   // An estimated level's own scatter, where kNoiseMargin does not cover it (a short recording).
   const double level_dof = options.noise_sigma ? 0.0 : static_cast<double>(fitted_count) / kSamplesPerNoiseDof;
-  const WindowFitter fitter(t, z, profile, options, curve.rounding_, level_dof < kMarginDof ? level_dof : 0.0);
+  const double uncertain_level_dof = level_dof < kMarginDof ? level_dof : 0.0;
+  const WindowFitter fitter(t, z, profile, options, curve.rounding_, uncertain_level_dof);
 
   // Segment boundaries [starts[k], starts[k+1]), with whether each segment ends at a jump; a
   // segment with one distinct stamp joins the neighbour across the shorter gap.
@@ -1286,7 +1287,8 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     bool changed = false;
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
       changed = internal::ReviseLocalSamples(t, z, starts[k], starts[k + 1], curve.segments_[k], local_rates[k],
-                                             window_rates, profile, regression, &local_samples[k]) ||
+                                             window_rates, profile, regression, uncertain_level_dof,
+                                             &local_samples[k]) ||
                 changed;
     }
     if (changed) {

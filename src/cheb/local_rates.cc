@@ -912,8 +912,13 @@ std::vector<LocalRun> BuildLocalRuns(const Eigen::VectorXd& t, const Eigen::Matr
 
 bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index last,
                         const CurveSegment& segment, const LocalRates& rates, const Eigen::MatrixXd& fit_rates,
-                        const NoiseProfile& noise, const std::vector<LocalRun>& regression, LocalSamples* chosen) {
+                        const NoiseProfile& noise, const std::vector<LocalRun>& regression, double level_dof,
+                        LocalSamples* chosen) {
   const Eigen::Index n = last - first, d = z.cols();
+  // σ² at the end of its range that counts against a change: a level read low makes the fit's rate
+  // noise, which the gain credits to it, look smaller than the local rates' (a 1 s clip whose σ
+  // read 27 % low went to the 3-point rate and followed its noise).
+  const double raised = level_dof > 0.0 ? 1.0 + kGainSignificance * std::sqrt(2.0 / level_dof) : 1.0;
   const std::vector<CurveWindow>& windows = segment.windows;
   const auto count = static_cast<Eigen::Index>(windows.size());
   if (n < 5 || count == 0 || rates.spline_slopes.rows() != n || rates.three_rates.rows() != n) return false;
@@ -996,7 +1001,7 @@ bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eige
         const double product = weights.spline_products[static_cast<size_t>(x)];
         squares[x](w, c) += square;
         noises[x](w, c) += variance * (2.0 * product - weights.spline_norm);
-        gains[x](w, c) += departure - square + 2.0 * variance * (shared - product);
+        gains[x](w, c) += departure - square + 2.0 * variance * (shared < product ? raised : 1.0) * (shared - product);
       }
       five_noise(w, c) += variance * weights.five_departure;
       if (present < 0) {

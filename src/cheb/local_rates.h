@@ -167,9 +167,12 @@ std::vector<char> NoisyLocalSamples(const Eigen::VectorXd& t, const Eigen::Matri
 /// close steps, nor at the fit's samples where the window's missed motion cannot hold their
 /// departure. Where the noise dominates motion near a quarter of the rate, windows of ~20 samples
 /// miss much of it and pass their residual test with σ read high (docs/velocity.md, "Local
-/// interpolant"). Returns whether any sample changed.
+/// interpolant"). `level_dof` > 0: the noise level is an estimate with that many degrees of freedom
+/// (a short recording), and a gain must hold with σ² raised by two of its standard deviations,
+/// sqrt(2/level_dof), where σ² counts against the change. Returns whether any sample changed.
 bool ReviseLocalSamples(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first, Eigen::Index last,
                         const CurveSegment& segment, const LocalRates& rates, const Eigen::MatrixXd& fit_rates,
-                        const NoiseProfile& noise, const std::vector<LocalRun>& regression, LocalSamples* chosen);
+                        const NoiseProfile& noise, const std::vector<LocalRun>& regression, double level_dof,
+                        LocalSamples* chosen);
 
 }  // namespace cheval::cheb::internal
