@@ -236,8 +236,7 @@ std::optional<ResidualTrend> TrendOf(const Eigen::VectorXd& t, const Eigen::Matr
 std::optional<Eigen::VectorXd> OwnVarianceFactor(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index end,
                                                  const CurveSegment& segment, Eigen::Index at) {
   const CurveWindow& own = at + 1 == end ? segment.windows.back() : segment.windows.front();
-  const std::optional<NestedCholesky> cholesky =
-      FactorWindow(t, z, own, *std::max_element(own.degrees.begin(), own.degrees.end()));
+  const std::optional<NestedCholesky> cholesky = FactorWindow(t, z, own);
   if (!cholesky) return std::nullopt;
   return RateVarianceFactor(*cholesky, own.series.interval, own.degrees, t[at]);
 }

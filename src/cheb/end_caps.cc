@@ -323,14 +323,8 @@ CurveWindow BuildCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::
   return cap;
 }
 
-// The factor of `window`'s normal matrix up to its highest degree; none where its samples no
-// longer determine it (repeated stamps).
-std::optional<NestedCholesky> FactorAtTop(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const CurveWindow& window) {
-  return FactorWindow(t, z, window, *std::max_element(window.degrees.begin(), window.degrees.end()));
-}
-
 // The variance of `window`'s rate at `count` samples from `at` on in direction `step` (±1), per
-// coordinate: σ²·dᵀG⁻¹d with the window's σ (`cholesky` its FactorAtTop); none without that σ.
+// coordinate: σ²·dᵀG⁻¹d with the window's σ (`cholesky` its FactorWindow); none without that σ.
 std::optional<Eigen::MatrixXd> RateVariance(const Eigen::VectorXd& t, const CurveWindow& window,
                                             const NestedCholesky& cholesky, Eigen::Index at, int step, Eigen::Index count) {
   const auto d = static_cast<Eigen::Index>(window.degrees.size());
@@ -366,8 +360,9 @@ void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloci
   // The end windows' factors: one when the segment is one window, whose two ends share it.
   std::array<std::optional<NestedCholesky>, 2> factors;
   if (spanned) {
-    ParallelFor(static_cast<int>(windows.size()), threads,
-                [&](int k) { factors[static_cast<size_t>(k)] = FactorAtTop(t, z, k == 0 ? windows.front() : windows.back()); });
+    ParallelFor(static_cast<int>(windows.size()), threads, [&](int k) {
+      factors[static_cast<size_t>(k)] = FactorWindow(t, z, k == 0 ? windows.front() : windows.back());
+    });
   }
   std::array<Choice, 2> choices;
   ParallelFor(2, threads, [&](int side) {

@@ -136,8 +136,9 @@ std::vector<Eigen::Index> SampleWindows(const Eigen::VectorXd& t, Eigen::Index f
   return owner;
 }
 
-std::optional<NestedCholesky> FactorWindow(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const CurveWindow& window,
-                                           int degree) {
+std::optional<NestedCholesky> FactorWindow(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const CurveWindow& window) {
+  if (window.degrees.empty()) return std::nullopt;
+  const int degree = *std::max_element(window.degrees.begin(), window.degrees.end());
   const auto first = std::lower_bound(t.data(), t.data() + t.size(), window.fit_begin) - t.data();
   const auto last = std::upper_bound(t.data(), t.data() + t.size(), window.fit_end) - t.data();
   try {
@@ -627,7 +628,7 @@ Eigen::VectorXd RateNoiseGains(const Eigen::VectorXd& t, const Eigen::MatrixXd& 
   const Eigen::Index last = std::upper_bound(t.data(), t.data() + t.size(), window.fit_end) - t.data();
   const Eigen::Index core_first = at(window.core_begin), core_last = at(window.core_end);
   if (top < 1 || core_last <= core_first || last - first <= top) return gains;
-  const std::optional<NestedCholesky> cholesky = FactorWindow(t, z, window, top);
+  const std::optional<NestedCholesky> cholesky = FactorWindow(t, z, window);
   if (!cholesky) return gains;
   const Interval& interval = window.series.interval;
   const Eigen::Index count = core_last - core_first, probes = std::min(count, kNoiseProbes);

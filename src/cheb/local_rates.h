@@ -20,10 +20,9 @@ class NoiseProfile;
 std::vector<Eigen::Index> SampleWindows(const Eigen::VectorXd& t, Eigen::Index first, Eigen::Index n,
                                         const std::vector<CurveWindow>& windows);
 
-/// The factor of the normal matrix, up to `degree`, of `window`'s samples (in the sorted stamps `t`,
-/// s, and values `z`), or none where it is singular (ComputeError).
-std::optional<NestedCholesky> FactorWindow(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const CurveWindow& window,
-                                           int degree);
+/// The factor of the normal matrix, up to its highest degree, of `window`'s samples (in the sorted
+/// stamps `t`, s, and values `z`), or none where it is singular (ComputeError) or has no degrees.
+std::optional<NestedCholesky> FactorWindow(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const CurveWindow& window);
 
 /// `window`'s values (order 0), rates (1) or second derivatives (2) at `times` (s), one row per time.
 Eigen::MatrixXd WindowSeriesAt(const CurveWindow& window, const Eigen::Ref<const Eigen::VectorXd>& times, int order);

@@ -188,7 +188,7 @@ class WindowWeights {
  public:
   WindowWeights(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const CurveWindow& window) : window_(window) {
     top_ = *std::max_element(window.degrees.begin(), window.degrees.end());
-    if (top_ >= 1) cholesky_ = FactorWindow(t, z, window, top_);
+    if (top_ >= 1) cholesky_ = FactorWindow(t, z, window);
   }
 
   // w_W·w_P per coordinate at time ti for the pilot `pilot` (on the segment's samples `ts`), and
