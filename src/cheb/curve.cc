@@ -31,12 +31,15 @@ namespace {
 // The relative tolerance below which coefficients are rounding, not signal: the chop's floor when
 // the data are noise-free.
 constexpr double kRoundingTolerance = 1e-13;
-// The noise level is a median over the recording's differences, and scatters like a variance
-// estimate with about one degree of freedom per kSamplesPerNoiseDof samples (measured on white
-// noise: 0.16–0.22 per sample from 100 to 1,000 samples). Where that is fewer than kMarginDof, the
-// level scatters by more than the 10 % that kNoiseMargin absorbs (a relative standard deviation of
-// 1/sqrt(2k)), and a level read low would make the residual test raise degrees to fit the noise.
+// The noise level, a scale of the recording's differences, scatters like a variance estimate with
+// about one degree of freedom per kSamplesPerNoiseDof samples where it is their median (measured on
+// white noise: 0.16–0.22 per sample from 100 to 1,000 samples), and per kSamplesPerWinsorizedDof
+// where it is Huber's winsorized scale, below DifferenceMagnitudes::kWinsorizedBelow samples
+// (0.32–0.35 per sample from 30 to 1,000). Where that is fewer than kMarginDof, the level scatters
+// by more than the 10 % that kNoiseMargin absorbs (a relative standard deviation of 1/sqrt(2k)),
+// and a level read low would make the residual test raise degrees to fit the noise.
 constexpr double kSamplesPerNoiseDof = 6.0;
+constexpr double kSamplesPerWinsorizedDof = 3.0;
 constexpr double kMarginDof = 50.0;
 // A window that passes the lack-of-fit test with a score above this (2 standard deviations, where
 // noise consistent with the 1.1σ margin rarely comes) is compared with its halves
@@ -1097,7 +1100,10 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   if (profile.varies()) curve.noise_sigma_max_ = profile.maximum();
   if (profile.stamp_noise()) curve.stamp_noise_s_ = std::sqrt(profile.stamp_noise()->variance);
   // An estimated level's own scatter, where kNoiseMargin does not cover it (a short recording).
-  const double level_dof = options.noise_sigma ? 0.0 : static_cast<double>(fitted_count) / kSamplesPerNoiseDof;
+  const double samples_per_dof = fitted_count < internal::DifferenceMagnitudes::kWinsorizedBelow
+                                     ? kSamplesPerWinsorizedDof
+                                     : kSamplesPerNoiseDof;
+  const double level_dof = options.noise_sigma ? 0.0 : static_cast<double>(fitted_count) / samples_per_dof;
   const double uncertain_level_dof = level_dof < kMarginDof ? level_dof : 0.0;
   const WindowFitter fitter(t, z, profile, options, curve.rounding_, uncertain_level_dof);
 

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 #include <vector>
 
@@ -143,16 +144,44 @@ Eigen::MatrixXd DividedDifferenceMagnitudes(const Eigen::Ref<const Eigen::Vector
 
 using internal::kMadScale;
 
-// kMadScale · the median of the magnitudes of rows [begin, end) of column c that are not NaN (zero
-// where there is none); `scratch` is reused.
-double ScaledMedian(const Eigen::MatrixXd& magnitudes, Eigen::Index begin, Eigen::Index end, Eigen::Index c,
-                    std::vector<double>* scratch) {
+// The winsorized scale's cut, in scales: at 2, on white noise's 4th differences of 100 samples the
+// scale scatters by 12 % against the median's 16 %, and a sample 20σ off raises it by 10 % against
+// the median's 7 % (simulated, 4,000 draws).
+constexpr double kWinsorCut = 2.0;
+
+// Huber's scale with a known centre (Huber & Ronchetti 2009, "Robust Statistics", §5.4): the s
+// with mean(min(x², (c·s)²)) = β(c)·s², β(c) = E min(X², c²) for X ~ N(0, 1), so that s is σ for
+// normal x. Fixed-point iteration from the median's scale `s`, which it converges to monotonically.
+double WinsorizedScale(const std::vector<double>& magnitudes, double s) {
+  constexpr double c = kWinsorCut;
+  const double tail = 0.5 * std::erfc(c / std::sqrt(2.0));                  // P(X > c)
+  const double density = std::exp(-0.5 * c * c) / std::sqrt(2.0 * std::numbers::pi);  // φ(c)
+  const double beta = (1.0 - 2.0 * tail) - 2.0 * c * density + 2.0 * c * c * tail;
+  const double n = static_cast<double>(magnitudes.size());
+  for (int iteration = 0; iteration < 100 && s > 0.0; ++iteration) {
+    const double cap = c * c * s * s;
+    double sum = 0.0;
+    for (const double x : magnitudes) sum += std::min(x * x, cap);
+    const double next = std::sqrt(sum / (beta * n));
+    const bool converged = std::abs(next - s) <= 1e-12 * s;
+    s = next;
+    if (converged) break;
+  }
+  return s;
+}
+
+// σ from the magnitudes of rows [begin, end) of column c that are not NaN (zero where there is
+// none): kMadScale · their median, or with `winsorized` Huber's scale started from it. `scratch`
+// is reused.
+double ScaleOf(const Eigen::MatrixXd& magnitudes, Eigen::Index begin, Eigen::Index end, Eigen::Index c,
+               bool winsorized, std::vector<double>* scratch) {
   scratch->clear();
   for (Eigen::Index i = begin; i < end; ++i) {
     if (!std::isnan(magnitudes(i, c))) scratch->push_back(magnitudes(i, c));
   }
   if (scratch->empty()) return 0.0;
-  return kMadScale * internal::SelectNonNegative(scratch, scratch->size() / 2);
+  const double median_scale = kMadScale * internal::SelectNonNegative(scratch, scratch->size() / 2);
+  return winsorized ? WinsorizedScale(*scratch, median_scale) : median_scale;
 }
 
 }  // namespace
@@ -213,11 +242,16 @@ DifferenceMagnitudes::DifferenceMagnitudes(const Eigen::Ref<const Eigen::VectorX
 }
 
 Eigen::VectorXd DifferenceMagnitudes::Sigma(Eigen::Index begin, Eigen::Index end) const {
-  return SigmaIfAbove(begin, end, Eigen::VectorXd::Constant(fourth_.cols(), -1.0));
+  return Estimate(begin, end, Eigen::VectorXd::Constant(fourth_.cols(), -1.0), end - begin < kWinsorizedBelow);
 }
 
 Eigen::VectorXd DifferenceMagnitudes::SigmaIfAbove(Eigen::Index begin, Eigen::Index end,
                                                    const Eigen::VectorXd& threshold) const {
+  return Estimate(begin, end, threshold, false);
+}
+
+Eigen::VectorXd DifferenceMagnitudes::Estimate(Eigen::Index begin, Eigen::Index end, const Eigen::VectorXd& threshold,
+                                               bool winsorized) const {
   const Eigen::Index d = fourth_.cols();
   const double root_m = std::sqrt(static_cast<double>(std::max<Eigen::Index>(end - begin, 1)));
   const double keep6 = 1.0 - std::min(kMaxMotionDrop, kDropDeviations * kRatioSpread6 / root_m);
@@ -225,11 +259,11 @@ Eigen::VectorXd DifferenceMagnitudes::SigmaIfAbove(Eigen::Index begin, Eigen::In
   Eigen::VectorXd sigma(d);
   std::vector<double> scratch;
   for (Eigen::Index c = 0; c < d; ++c) {
-    const double fourth = ScaledMedian(fourth_, begin, end, c, &scratch);
+    const double fourth = ScaleOf(fourth_, begin, end, c, winsorized, &scratch);
     sigma[c] = fourth;
     if (!(fourth > threshold[c])) continue;  // the higher orders only ever lower it
-    const double sixth = ScaledMedian(sixth_, begin, end, c, &scratch);
-    const double eighth = ScaledMedian(eighth_, begin, end, c, &scratch);
+    const double sixth = ScaleOf(sixth_, begin, end, c, winsorized, &scratch);
+    const double eighth = ScaleOf(eighth_, begin, end, c, winsorized, &scratch);
     if (sixth < keep6 * fourth) sigma[c] = sixth;
     if (eighth < keep8 * fourth) sigma[c] = std::min(sigma[c], eighth);
   }

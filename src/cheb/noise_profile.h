@@ -27,11 +27,13 @@ class DifferenceMagnitudes {
   DifferenceMagnitudes(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
                        const std::vector<Eigen::Index>& breaks, int threads = 1);
 
-  /// EstimateNoiseSigma's estimate from the runs that start at samples [begin, end).
+  /// EstimateNoiseSigma's estimate from the runs that start at samples [begin, end): kMadScale ·
+  /// the median magnitude, or over fewer than kWinsorizedBelow samples Huber's winsorized scale
+  /// (docs/velocity.md, "Noise estimate").
   Eigen::VectorXd Sigma(Eigen::Index begin, Eigen::Index end) const;
-  /// The same where it exceeds `threshold` (per coordinate); elsewhere a value no larger than
-  /// `threshold`: the 4th differences' estimate, which the higher orders only ever lower. A third
-  /// of the cost where a stretch is not noisier.
+  /// The median's estimate where it exceeds `threshold` (per coordinate); elsewhere a value no
+  /// larger than `threshold`: the 4th differences' estimate, which the higher orders only ever
+  /// lower. A third of the cost where a stretch is not noisier.
   Eigen::VectorXd SigmaIfAbove(Eigen::Index begin, Eigen::Index end, const Eigen::VectorXd& threshold) const;
   /// For telling where SigmaIfAbove can exceed `threshold` without a median: per coordinate c, the
   /// number of usable runs starting before each sample (column 2c) and of those whose 4th
@@ -49,7 +51,16 @@ class DifferenceMagnitudes {
   /// value is not finite.
   const Eigen::MatrixXd& rates() const { return rates_; }
 
+  /// Below this many samples the median's scatter exceeds what the residual test's 10 % margin
+  /// covers (about m/6 degrees of freedom: under 50), and Sigma takes Huber's winsorized scale,
+  /// with m/3. Longer stretches keep the median: motion in the differences' tails (EuRoC's
+  /// vibration) reaches a mean of squares far more than the median.
+  static constexpr Eigen::Index kWinsorizedBelow = 300;
+
  private:
+  Eigen::VectorXd Estimate(Eigen::Index begin, Eigen::Index end, const Eigen::VectorXd& threshold,
+                           bool winsorized) const;
+
   Eigen::MatrixXd fourth_, sixth_, eighth_;  // m x d, NaN where no usable run starts
   Eigen::MatrixXd rates_;
 };
