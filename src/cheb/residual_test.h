@@ -7,13 +7,15 @@
 
 #include <Eigen/Core>
 
+#include "cheval/cheb/curve.h"
+
 namespace cheval::cheb::internal {
 
 // A window's residual is consistent with the noise while its lack-of-fit score (a standard normal
-// score of χ²) stays below this: a false alarm per coordinate and window has probability 0.13 %
-// (a split that costs little), while at 4 small unresolved motion (a tremor of twice the noise)
-// passes in short windows (docs/decisions.md).
-inline constexpr double kLackOfFitLimit = 3.0;
+// score of χ²) stays below cheb::kLackOfFitLimit = 3 (curve.h): a false alarm per coordinate and
+// window has probability 0.13 % (a split that costs little), while at 4 small unresolved motion (a
+// tremor of twice the noise) passes in short windows (docs/decisions.md).
+using cheb::kLackOfFitLimit;
 // The residual is tested against the noise σ times this: σ is an estimate and the noise of real
 // data (and of rotation charts, J_r⁻¹ stretched) varies by some per cent, which in a window of
 // hundreds of samples a χ² test alone would take for unresolved motion (it made the drone's body

@@ -334,24 +334,41 @@ traj::Trajectory VelocityTrajectory(const traj::TrajectoryView& input, const Vel
 }
 
 std::string UnresolvedWarning(const cheb::Curve& curve) {
+  // The unresolved windows whose residual fails the test, and the largest residual over the noise
+  // among them, or among all unresolved windows where none fails: a window at the smallest size
+  // can also be unresolved with a residual that passes the test: its coefficients could not show
+  // the motion resolved.
   const cheb::CurveWindow* worst = nullptr;
   double worst_ratio = 0.0;
-  for (const cheb::CurveSegment& segment : curve.segments()) {
-    for (const cheb::CurveWindow& w : segment.windows) {
-      if (w.verdict != cheb::WindowVerdict::kUnresolved || w.residual_rms.size() != curve.dimension()) continue;
-      // Against the σ the window was tested against (the noise profile's), where it has one.
-      const Eigen::VectorXd& sigma = w.noise_sigma.size() == w.residual_rms.size() ? w.noise_sigma : curve.noise_sigma();
-      for (Eigen::Index c = 0; c < w.residual_rms.size(); ++c) {
-        const double ratio = sigma[c] > 0.0 ? w.residual_rms[c] / sigma[c] : 0.0;
-        if (worst == nullptr || ratio > worst_ratio) worst = &w, worst_ratio = ratio;
+  Eigen::Index failing = 0;
+  for (const bool fails : {true, false}) {
+    for (const cheb::CurveSegment& segment : curve.segments()) {
+      for (const cheb::CurveWindow& w : segment.windows) {
+        if (w.verdict != cheb::WindowVerdict::kUnresolved || w.residual_rms.size() != curve.dimension()) continue;
+        if (fails && !(w.lack_of_fit.size() > 0 && w.lack_of_fit.maxCoeff() > cheb::kLackOfFitLimit)) continue;
+        failing += fails ? 1 : 0;
+        // Against the σ the window was tested against (the noise profile's), where it has one.
+        const Eigen::VectorXd& sigma = w.noise_sigma.size() == w.residual_rms.size() ? w.noise_sigma : curve.noise_sigma();
+        for (Eigen::Index c = 0; c < w.residual_rms.size(); ++c) {
+          const double ratio = sigma[c] > 0.0 ? w.residual_rms[c] / sigma[c] : 0.0;
+          if (worst == nullptr || ratio > worst_ratio) worst = &w, worst_ratio = ratio;
+        }
       }
     }
+    if (worst != nullptr) break;
   }
   if (worst == nullptr) return {};
+  if (failing == 0) {
+    return fmt::format(
+        "{} window(s) at the smallest size could not show the motion resolved, though their residual passes the "
+        "residual test (at most {:.1f}x the noise, {:.3f}..{:.3f} s from the first sample): their velocity may miss "
+        "fast motion there (--json lists them)",
+        curve.unresolved_windows(), worst_ratio, worst->fit_begin, worst->fit_end);
+  }
   const std::string where = fmt::format(
       "{} window(s) still fail the residual test at the smallest window; the worst, {:.3f}..{:.3f} s from the first "
       "sample, has a residual {:.1f}x the noise",
-      curve.unresolved_windows(), worst->fit_begin, worst->fit_end, worst_ratio);
+      failing, worst->fit_begin, worst->fit_end, worst_ratio);
   if (curve.local_samples() == 0) return where + ": its velocity may miss motion there (--json lists them)";
   return fmt::format("{}: where the residual is clearly above the noise the velocity comes from the samples' local "
                      "interpolant ({} samples; --json lists the windows)",

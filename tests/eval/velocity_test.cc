@@ -15,6 +15,8 @@
 
 #include "cheval/common/error.h"
 #include "cheval/eval/velocity.h"
+#include "cheval/cheb/curve.h"
+#include "cheval/sim/motion.h"
 #include "cheval/traj/io.h"
 #include "eval_test_util.h"
 #include "expect_option_error.h"
@@ -392,6 +394,62 @@ TEST(EstimateVelocity, QuaternionsRoundedToFourDecimalsGiveTheirChartsTheirNoise
   auto rms = [&](const Eigen::Matrix3Xd& rates) { return std::sqrt((rates - truth).colwise().squaredNorm().mean()); };
   const double fit = rms(estimate.angular_velocities), differences = rms(central.angular_velocities);
   EXPECT_LT(fit, 0.05 * differences) << fit << " vs central " << differences;
+}
+
+// The warning about windows accepted unresolved says what is true of them. A literal window that
+// cannot follow a tone at a quarter of the rate fails the residual test, and the warning says so
+// with its residual. Short clips' windows at the smallest size can be unresolved with a residual
+// that passes the residual test (their coefficients could not show the motion resolved): the
+// warning then says so, not that it fails (it said "still fail the residual test ... residual
+// 1.0x the noise" before).
+TEST(VelocityTest, TheUnresolvedWarningSaysWhetherTheResidualFails) {
+  {
+    const int m = 200;
+    std::vector<int64_t> stamps;
+    Eigen::MatrixXd z(m, 3);
+    for (int i = 0; i < m; ++i) {
+      stamps.push_back(int64_t{10'000'000} * i);
+      const double t = 0.01 * i;
+      z.row(i) << 1e-3 * std::sin(2.0 * M_PI * 24.0 * t), 0.1 * t, 1e-4 * std::cos(7.0 * i);
+    }
+    cheb::CurveOptions options;
+    options.single_window = true;
+    const cheb::Curve curve = cheb::FitCurve(stamps, z, options);
+    ASSERT_EQ(curve.unresolved_windows(), 1);
+    const std::string warning = UnresolvedWarning(curve);
+    EXPECT_NE(warning.find("1 window(s) still fail the residual test"), std::string::npos) << warning;
+  }
+  int within = 0;
+  for (uint64_t seed = 1; seed <= 8; ++seed) {
+    sim::MotionOptions motion;
+    motion.kind = sim::MotionKind::kCar;
+    motion.seed = seed;
+    motion.duration_s = 0.3;
+    motion.rate_hz = 100.0;
+    sim::MeasurementOptions measurement;
+    measurement.noise_m = 0.5e-3;
+    const traj::Trajectory measured = sim::Measure(sim::MotionModel(motion), measurement);
+    const cheb::Curve curve = cheb::FitCurve({measured.stamps_ns().begin(), measured.stamps_ns().end()},
+                                             Eigen::MatrixXd(measured.positions().transpose()));
+    int failing = 0;
+    for (const cheb::CurveSegment& segment : curve.segments()) {
+      for (const cheb::CurveWindow& w : segment.windows) {
+        const bool fails = w.lack_of_fit.size() > 0 && w.lack_of_fit.maxCoeff() > cheb::kLackOfFitLimit;
+        failing += w.verdict == cheb::WindowVerdict::kUnresolved && fails ? 1 : 0;
+      }
+    }
+    const std::string warning = UnresolvedWarning(curve);
+    if (curve.unresolved_windows() == 0) {
+      EXPECT_TRUE(warning.empty()) << warning;
+    } else if (failing == 0) {
+      ++within;
+      EXPECT_EQ(warning.find("fail"), std::string::npos) << "seed " << seed << ": " << warning;
+      EXPECT_NE(warning.find("their residual passes the residual test"), std::string::npos) << warning;
+    } else {
+      EXPECT_NE(warning.find(std::to_string(failing) + " window(s) still fail"), std::string::npos) << warning;
+    }
+  }
+  EXPECT_GT(within, 0) << "no clip had windows unresolved with a residual that passes";
 }
 
 }  // namespace

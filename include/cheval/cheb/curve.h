@@ -140,6 +140,10 @@ enum class WindowVerdict {
 /// "resolved", "unresolved", "fixed_degree" or "bridge" (the JSON and the report name verdicts so).
 std::string_view ToString(WindowVerdict verdict);
 
+/// A window's residual is consistent with the noise while every coordinate's lack_of_fit score
+/// stays at or below this (docs/velocity.md, "Residual test").
+inline constexpr double kLackOfFitLimit = 3.0;
+
 /// One window: its core [core_begin, core_end] (seconds from the curve's origin), the samples used
 /// and the fit, with a degree per coordinate (coefficients of lower-degree coordinates are padded
 /// with zeros).
@@ -157,7 +161,7 @@ struct CurveWindow {
   Eigen::VectorXd residual_rms;
   /// The lack-of-fit statistic per coordinate: the residual sum of squares over σ² is χ² with
   /// m − N − 1 degrees of freedom for a fit that has resolved the motion; this is its standard
-  /// normal score (Wilson–Hilferty), accepted up to 3 (diagnostics).
+  /// normal score (Wilson–Hilferty), accepted up to kLackOfFitLimit (diagnostics).
   Eigen::VectorXd lack_of_fit;
   /// The noise σ per coordinate the residual was tested against: the noise profile's over the
   /// window's samples (Curve::noisier_samples), floored at the values' rounding level (diagnostics).
