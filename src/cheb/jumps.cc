@@ -401,14 +401,14 @@ Jumps FindJumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
       // slope that undoes this one's displacement.
       const Eigen::VectorXd displacement = e * scan.dt(j);
       std::optional<Eigen::Index> partner;
-      double best = 0.5;
+      double best_mismatch = 0.5;
       for (const Eigen::Index k : {j - 1, j + 1}) {
         if (k < 0 || k >= n || disagreement.norm() > 0.5 * e.norm()) continue;
         Eigen::VectorXd ek;
         if (scan.Score(k, scale, &ek) <= 0.5 * kThreshold) continue;
         const Eigen::VectorXd dk = ek * scan.dt(k);
         const double mismatch = (displacement + dk).norm() / std::max(displacement.norm(), dk.norm());
-        if (mismatch < best) best = mismatch, partner = k;
+        if (mismatch < best_mismatch) best_mismatch = mismatch, partner = k;
       }
       // Else an excursion: a few consecutive samples leave the motion, each its own way, and the
       // samples on either side connect as if they were not there. The shortest one through slope j
