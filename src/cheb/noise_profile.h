@@ -29,7 +29,7 @@ class DifferenceMagnitudes {
 
   /// EstimateNoiseSigma's estimate from the runs that start at samples [begin, end): kMadScale ·
   /// the median magnitude, or over fewer than kWinsorizedBelow samples Huber's winsorized scale
-  /// (docs/velocity.md, "Noise estimate").
+  /// where the differences' tails are white noise's (docs/velocity.md, "Noise estimate").
   Eigen::VectorXd Sigma(Eigen::Index begin, Eigen::Index end) const;
   /// The median's estimate where it exceeds `threshold` (per coordinate); elsewhere a value no
   /// larger than `threshold`: the 4th differences' estimate, which the higher orders only ever
@@ -53,8 +53,8 @@ class DifferenceMagnitudes {
 
   /// Below this many samples the median's scatter exceeds what the residual test's 10 % margin
   /// covers (about m/6 degrees of freedom: under 50), and Sigma takes Huber's winsorized scale,
-  /// with m/3. Longer stretches keep the median: motion in the differences' tails (EuRoC's
-  /// vibration) reaches a mean of squares far more than the median.
+  /// with m/3, where it agrees with the median's. Longer stretches keep the median: motion in the
+  /// differences' tails (EuRoC's vibration) reaches a mean of squares far more than the median.
   static constexpr Eigen::Index kWinsorizedBelow = 300;
 
  private:

@@ -29,7 +29,8 @@ Eigen::VectorXd EstimateNoiseSigma(const Eigen::Ref<const Eigen::MatrixXd>& z, i
 /// deviation σ under white noise. σ̂ = 1.4826 · median of its magnitude; over fewer than 300
 /// samples, where the median scatters by more than 10 %, Huber's winsorized scale (the s with
 /// mean(min(x², 4s²)) = 0.774·s², from the median's value; docs/velocity.md, "Noise estimate"),
-/// which scatters by a quarter less. For even spacing and 300 samples or more this is
+/// which scatters by a quarter less, wherever it agrees with the median's as white noise's do (in
+/// heavier tails lies motion). For even spacing and 300 samples or more this is
 /// exactly the 4th-difference estimate above; with stamp jitter or uneven sampling that one
 /// mistakes the spacing for noise (a velocity v and a jitter δt look like noise v·δt). Runs with
 /// two equal stamps, and runs that cross a boundary in `breaks` (a run may not contain both
