@@ -1100,6 +1100,9 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   if (profile.varies()) curve.noise_sigma_max_ = profile.maximum();
   if (profile.stamp_noise()) curve.stamp_noise_s_ = std::sqrt(profile.stamp_noise()->variance);
   // An estimated level's own scatter, where kNoiseMargin does not cover it (a short recording).
+  // Under kWinsorizedBelow samples the winsorized scale's, also where a coordinate kept the median
+  // for its heavy tails (with the median's for every short recording the clips' errors were the
+  // same; docs/velocity.md, "Short recordings").
   const double samples_per_dof = fitted_count < internal::DifferenceMagnitudes::kWinsorizedBelow
                                      ? kSamplesPerWinsorizedDof
                                      : kSamplesPerNoiseDof;
