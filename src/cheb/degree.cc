@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -179,37 +180,34 @@ double WinsorizedScale(const std::vector<double>& magnitudes, double s) {
 // vibration in the differences' tails) read 2.3–3x.
 constexpr double kTailDeviations = 3.0;
 
-// The magnitudes of rows [begin, end) of column c that are not NaN, into `values`.
-void Magnitudes(const Eigen::MatrixXd& magnitudes, Eigen::Index begin, Eigen::Index end, Eigen::Index c,
-                std::vector<double>* values) {
-  values->clear();
-  for (Eigen::Index i = begin; i < end; ++i) {
-    if (!std::isnan(magnitudes(i, c))) values->push_back(magnitudes(i, c));
+// One order's σ over a stretch of one coordinate: kMadScale · the median of its magnitudes, and
+// where asked Huber's scale started from it (zero where no run is usable).
+struct OrderScale {
+  double median = 0.0, winsorized = 0.0;
+  size_t runs = 0;
+
+  // Whether its tails are like white noise's: the winsorized scale within kTailDeviations of the
+  // median's.
+  bool TailsLikeWhiteNoise() const {
+    const double agreement = 1.0 + kTailDeviations / std::sqrt(static_cast<double>(std::max<size_t>(runs, 1)));
+    return winsorized <= agreement * median;
   }
-}
+};
 
-// kMadScale · the median of `values` (zero where there is none); they are reordered.
-double MedianScale(std::vector<double>* values) {
-  return values->empty() ? 0.0 : kMadScale * internal::SelectNonNegative(values, values->size() / 2);
-}
-
-// σ from the magnitudes of rows [begin, end) of column c (zero where there is none): kMadScale ·
-// their median, or with `winsorized` Huber's scale started from it. `scratch` is reused.
-double ScaleOf(const Eigen::MatrixXd& magnitudes, Eigen::Index begin, Eigen::Index end, Eigen::Index c,
-               bool winsorized, std::vector<double>* scratch) {
-  Magnitudes(magnitudes, begin, end, c, scratch);
-  const double median_scale = MedianScale(scratch);
-  return winsorized ? WinsorizedScale(*scratch, median_scale) : median_scale;
-}
-
-// Whether column c of one order's magnitudes over [begin, end) has tails like white noise's: their
-// winsorized scale within kTailDeviations of the median's.
-bool TailsLikeWhiteNoise(const Eigen::MatrixXd& magnitudes, Eigen::Index begin, Eigen::Index end, Eigen::Index c,
-                         std::vector<double>* scratch) {
-  Magnitudes(magnitudes, begin, end, c, scratch);
-  const double median_scale = MedianScale(scratch);
-  const double agreement = 1.0 + kTailDeviations / std::sqrt(static_cast<double>(std::max<size_t>(scratch->size(), 1)));
-  return WinsorizedScale(*scratch, median_scale) <= agreement * median_scale;
+// The scales of the magnitudes of rows [begin, end) of column c that are not NaN; the winsorized one
+// only `with_winsorized`. `scratch` is reused.
+OrderScale ScaleOf(const Eigen::MatrixXd& magnitudes, Eigen::Index begin, Eigen::Index end, Eigen::Index c,
+                   bool with_winsorized, std::vector<double>* scratch) {
+  scratch->clear();
+  for (Eigen::Index i = begin; i < end; ++i) {
+    if (!std::isnan(magnitudes(i, c))) scratch->push_back(magnitudes(i, c));
+  }
+  OrderScale scale;
+  scale.runs = scratch->size();
+  if (scratch->empty()) return scale;
+  scale.median = kMadScale * internal::SelectNonNegative(scratch, scratch->size() / 2);
+  if (with_winsorized) scale.winsorized = WinsorizedScale(*scratch, scale.median);
+  return scale;
 }
 
 }  // namespace
@@ -287,16 +285,23 @@ Eigen::VectorXd DifferenceMagnitudes::Estimate(Eigen::Index begin, Eigen::Index 
   Eigen::VectorXd sigma(d);
   std::vector<double> scratch;
   for (Eigen::Index c = 0; c < d; ++c) {
+    auto scale_of = [&](const Eigen::MatrixXd& magnitudes) {
+      return ScaleOf(magnitudes, begin, end, c, winsorized, &scratch);
+    };
     // The same scale for the three orders, which are compared: the winsorized where the tails of
-    // all three are white noise's.
-    const bool efficient = winsorized && TailsLikeWhiteNoise(fourth_, begin, end, c, &scratch) &&
-                           TailsLikeWhiteNoise(sixth_, begin, end, c, &scratch) &&
-                           TailsLikeWhiteNoise(eighth_, begin, end, c, &scratch);
-    const double fourth = ScaleOf(fourth_, begin, end, c, efficient, &scratch);
+    // all three are white noise's. Without it, the higher orders only where the 4th's exceeds the
+    // threshold (they only ever lower it).
+    const OrderScale fourth_scale = scale_of(fourth_);
+    std::optional<OrderScale> sixth_scale, eighth_scale;
+    if (winsorized) sixth_scale = scale_of(sixth_), eighth_scale = scale_of(eighth_);
+    const bool efficient = winsorized && fourth_scale.TailsLikeWhiteNoise() && sixth_scale->TailsLikeWhiteNoise() &&
+                           eighth_scale->TailsLikeWhiteNoise();
+    auto chosen = [efficient](const OrderScale& scale) { return efficient ? scale.winsorized : scale.median; };
+    const double fourth = chosen(fourth_scale);
     sigma[c] = fourth;
-    if (!(fourth > threshold[c])) continue;  // the higher orders only ever lower it
-    const double sixth = ScaleOf(sixth_, begin, end, c, efficient, &scratch);
-    const double eighth = ScaleOf(eighth_, begin, end, c, efficient, &scratch);
+    if (!(fourth > threshold[c])) continue;
+    if (!sixth_scale) sixth_scale = scale_of(sixth_), eighth_scale = scale_of(eighth_);
+    const double sixth = chosen(*sixth_scale), eighth = chosen(*eighth_scale);
     if (sixth < keep6 * fourth) sigma[c] = sixth;
     if (eighth < keep8 * fourth) sigma[c] = std::min(sigma[c], eighth);
   }
