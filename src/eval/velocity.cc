@@ -334,30 +334,36 @@ traj::Trajectory VelocityTrajectory(const traj::TrajectoryView& input, const Vel
 }
 
 std::string UnresolvedWarning(const cheb::Curve& curve) {
-  // The unresolved windows whose residual fails the test, and the largest residual over the noise
-  // among them, or among all unresolved windows where none fails: a window at the smallest size
-  // can also be unresolved with a residual that passes the test: its coefficients could not show
-  // the motion resolved.
-  const cheb::CurveWindow* worst = nullptr;
-  double worst_ratio = 0.0;
+  // The largest residual over the noise among the unresolved windows whose residual fails the
+  // test, or among all unresolved windows where none fails: a window at the smallest size can also
+  // be unresolved with a residual that passes the test: its coefficients could not show the motion
+  // resolved.
+  struct Worst {
+    const cheb::CurveWindow* window = nullptr;
+    double ratio = 0.0;
+    void Offer(const cheb::CurveWindow& w, double r) {
+      if (window == nullptr || r > ratio) window = &w, ratio = r;
+    }
+  } failing_worst, any_worst;
   Eigen::Index failing = 0;
-  for (const bool fails : {true, false}) {
-    for (const cheb::CurveSegment& segment : curve.segments()) {
-      for (const cheb::CurveWindow& w : segment.windows) {
-        if (w.verdict != cheb::WindowVerdict::kUnresolved || w.residual_rms.size() != curve.dimension()) continue;
-        if (fails && !(w.lack_of_fit.size() > 0 && w.lack_of_fit.maxCoeff() > cheb::kLackOfFitLimit)) continue;
-        failing += fails ? 1 : 0;
-        // Against the σ the window was tested against (the noise profile's), where it has one.
-        const Eigen::VectorXd& sigma = w.noise_sigma.size() == w.residual_rms.size() ? w.noise_sigma : curve.noise_sigma();
-        for (Eigen::Index c = 0; c < w.residual_rms.size(); ++c) {
-          const double ratio = sigma[c] > 0.0 ? w.residual_rms[c] / sigma[c] : 0.0;
-          if (worst == nullptr || ratio > worst_ratio) worst = &w, worst_ratio = ratio;
-        }
+  for (const cheb::CurveSegment& segment : curve.segments()) {
+    for (const cheb::CurveWindow& w : segment.windows) {
+      if (w.verdict != cheb::WindowVerdict::kUnresolved || w.residual_rms.size() != curve.dimension()) continue;
+      const bool fails = w.lack_of_fit.size() > 0 && w.lack_of_fit.maxCoeff() > cheb::kLackOfFitLimit;
+      failing += fails ? 1 : 0;
+      // Against the σ the window was tested against (the noise profile's), where it has one.
+      const Eigen::VectorXd& sigma = w.noise_sigma.size() == w.residual_rms.size() ? w.noise_sigma : curve.noise_sigma();
+      for (Eigen::Index c = 0; c < w.residual_rms.size(); ++c) {
+        const double ratio = sigma[c] > 0.0 ? w.residual_rms[c] / sigma[c] : 0.0;
+        any_worst.Offer(w, ratio);
+        if (fails) failing_worst.Offer(w, ratio);
       }
     }
-    if (worst != nullptr) break;
   }
-  if (worst == nullptr) return {};
+  const Worst& worst_of = failing > 0 ? failing_worst : any_worst;
+  if (worst_of.window == nullptr) return {};
+  const cheb::CurveWindow* worst = worst_of.window;
+  const double worst_ratio = worst_of.ratio;
   if (failing == 0) {
     return fmt::format(
         "{} window(s) at the smallest size could not show the motion resolved, though their residual passes the "
