@@ -28,7 +28,7 @@ NOISES = (0.0005, 0.002)
 
 
 def clip(cheval, folder, kind, duration, noise, seed):
-    """cheval's, its ends', the oracle's and central differences' squared errors summed, and the samples."""
+    """One clip's velocity RMSE (m/s): cheval's, at its first and last three samples, the oracle's, central differences'."""
     measured, truth, out = (os.path.join(folder, name) for name in ("m.tum", "t.tum", "o.tum"))
     subprocess.run([cheval, "sim", "motion", "--kind", kind, "--duration", str(duration), "--rate", "100",
                     "--noise", str(noise), "--seed", str(seed), "-o", measured, "--truth", truth],
