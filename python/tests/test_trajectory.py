@@ -328,17 +328,17 @@ class InputLimitsTest(unittest.TestCase):
         self.assertTrue(err.startswith(fifo + ":1:1: error: no newline in the first "), err)
 
     def test_an_input_larger_than_the_memory_left_is_exit_2_not_an_internal_error(self):
-        path = self.path("big.txt", "1.000000000 0.5 0.25 0.125 0 0 0 1\n" * 1_000_000)  # 35 MB
-        limit = 100 * 2**20  # address space for the whole process: the file does not fit twice
+        path = self.path("big.txt", "1.000000000 0.5 0.25 0.125 0 0 0 1\n" * 3_000_000)  # 105 MB
+        limit = 100 * 2**20  # address space for the whole process: the poses (192 MB) do not fit
 
         def limited():
             resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
 
         done = subprocess.run([CLI, "info", path], capture_output=True, text=True, preexec_fn=limited, check=False)
         self.assertEqual(done.returncode, 2, done.stderr)
-        self.assertEqual(done.stderr, path + ":0:0: error: not enough memory to read the file of 35000000 bytes "
-                         "(33.4 MiB): the text and the poses need about twice its size; expected a smaller file or "
-                         "more free memory\n")
+        self.assertEqual(done.stderr, path + ":0:0: error: not enough memory to read the file of 105000000 bytes "
+                         "(100 MiB): its poses need up to about twice its size; expected a smaller file or more free "
+                         "memory\n")
 
 
 if __name__ == "__main__":

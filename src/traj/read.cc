@@ -32,15 +32,128 @@ struct Field {
   int64_t column;  // 1-based column of the first character
 };
 
-// Walks over the lines of a text, skipping blank lines and `#` comments.
+// "N bytes (X MiB)" for messages about sizes.
+std::string Bytes(uint64_t bytes) {
+  return bytes >= (uint64_t{1} << 30) ? fmt::format("{} bytes ({:.3g} GiB)", bytes, static_cast<double>(bytes) / (1 << 30))
+                                      : fmt::format("{} bytes ({:.3g} MiB)", bytes, static_cast<double>(bytes) / (1 << 20));
+}
+
+// An input file read a block at a time, each block checked as it arrives: no NUL byte (a text file
+// has none; /dev/zero and binary files stop at the first block), no line longer than
+// kMaxInputLineBytes, and no more than MaxInputFileBytes() in all. So a FIFO, a device or a file
+// without newlines is refused after at most a block past kMaxInputLineBytes, and a large file is
+// never held whole in memory: the scanner keeps only the lines it has not reached yet.
+class BlockReader {
+ public:
+  explicit BlockReader(std::string path) : path_(std::move(path)), file_(nullptr, &std::fclose) {
+    if (path_.find('\0') != std::string::npos) {
+      throw InputError(QuoteField(path_, std::string::npos), 0, 0,
+                       "the file name contains a NUL byte (\\0); expected a path");
+    }
+    file_.reset(std::fopen(path_.c_str(), "rb"));
+    if (file_ == nullptr) throw InputError(path_, 0, 0, fmt::format("cannot open file: {}", std::strerror(errno)));
+    struct stat status {};
+    if (fstat(fileno(file_.get()), &status) != 0) {
+      throw InputError(path_, 0, 0, fmt::format("cannot read file: {}", std::strerror(errno)));
+    }
+    if (S_ISDIR(status.st_mode)) throw InputError(path_, 0, 0, "is a directory; expected a trajectory file");
+    if (S_ISREG(status.st_mode)) {
+      size_ = static_cast<uint64_t>(status.st_size);
+      if (size_ > limit_) throw TooLarge(size_, "the file is");
+    }
+  }
+
+  // The file's size where it is a regular file, else 0 (only to reserve memory).
+  uint64_t size() const { return size_; }
+
+  // Appends the next block of the file to `buffer`; false at its end.
+  bool Append(std::string* buffer) {
+    if (done_) return false;
+    const size_t old = buffer->size();
+    buffer->resize(old + kBlockBytes);
+    const size_t n = std::fread(buffer->data() + old, 1, kBlockBytes, file_.get());
+    buffer->resize(old + n);
+    if (n == 0) {
+      done_ = true;
+      if (std::ferror(file_.get())) {
+        throw InputError(path_, 0, 0, fmt::format("cannot read file: {}", std::strerror(errno)));
+      }
+      return false;
+    }
+    Check(std::string_view(*buffer).substr(old));
+    read_ += n;
+    if (read_ > limit_) throw TooLarge(read_, "the input is more than");
+    return true;
+  }
+
+ private:
+  static constexpr size_t kBlockBytes = size_t{1} << 20;
+
+  InputError TooLarge(uint64_t size, const char* what) const {
+    return InputError(path_, 0, 0,
+                      fmt::format("{} {}; the largest input file read is {} (the smaller of 8 GiB and half the "
+                                  "physical memory)",
+                                  what, Bytes(size), Bytes(limit_)));
+  }
+
+  // Checks a new block; line_ and line_bytes_ (the length of the line so far) carry over.
+  void Check(std::string_view block) {
+    const auto fail_long = [&](size_t length) {
+      throw InputError(path_, line_, 1,
+                       fmt::format("no newline in the first {} of this line; expected lines of a trajectory file, "
+                                   "at most {} each",
+                                   Bytes(length), Bytes(kMaxInputLineBytes)));
+    };
+    const size_t nul = block.find('\0');
+    const size_t stop = nul == std::string_view::npos ? block.size() : nul;
+    size_t line_start = 0;  // in `block`; the line began line_bytes_ before the block
+    size_t carried = line_bytes_;
+    for (size_t i = 0; i < stop;) {
+      const void* found = std::memchr(block.data() + i, '\n', stop - i);
+      if (found == nullptr) break;
+      const size_t newline = static_cast<size_t>(static_cast<const char*>(found) - block.data());
+      if (carried + newline - line_start > kMaxInputLineBytes) fail_long(carried + newline - line_start);
+      line_start = newline + 1;
+      carried = 0;
+      ++line_;
+      i = newline + 1;
+    }
+    line_bytes_ = carried + stop - line_start;
+    if (line_bytes_ > kMaxInputLineBytes) fail_long(line_bytes_);
+    if (nul != std::string_view::npos) {
+      throw InputError(path_, line_, static_cast<int64_t>(line_bytes_) + 1,
+                       "contains a NUL byte (\\0); expected a text file");
+    }
+  }
+
+  std::string path_;
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file_;
+  uint64_t limit_ = MaxInputFileBytes();
+  uint64_t size_ = 0;
+  uint64_t read_ = 0;
+  int64_t line_ = 1;
+  size_t line_bytes_ = 0;
+  bool done_ = false;
+};
+
+// Walks over the lines of a text, skipping blank lines and `#` comments: a text in memory, or a file
+// streamed through a buffer. A line's view (and its fields') holds until the next call of Next().
 class LineScanner {
  public:
   explicit LineScanner(std::string_view content) : content_(content) {}
 
+  // Streams `file` through `buffer`, starting with what the buffer holds already (text read from the
+  // same file). With `keep`, the buffer keeps every line (a look at the first lines, read again
+  // later from the buffer); without, the lines behind are dropped as the buffer is refilled.
+  LineScanner(BlockReader* file, std::string* buffer, bool keep)
+      : content_(*buffer), file_(file), buffer_(buffer), keep_(keep) {}
+
   // Moves to the next data line; false at the end of the text.
   bool Next() {
-    while (position_ < content_.size()) {
-      const size_t end = content_.find('\n', position_);
+    while (true) {
+      size_t end = content_.find('\n', position_);
+      while (end == std::string_view::npos && Refill()) end = content_.find('\n', position_);
+      if (position_ >= content_.size()) return false;
       has_newline_ = end != std::string_view::npos;
       const size_t stop = has_newline_ ? end : content_.size();
       line_ = content_.substr(position_, stop - position_);
@@ -55,7 +168,6 @@ class LineScanner {
       }
       return true;
     }
-    return false;
   }
 
   std::string_view line() const { return line_; }
@@ -98,12 +210,28 @@ class LineScanner {
   int64_t end_column() const { return static_cast<int64_t>(line_.size()) + 1; }
 
  private:
+  // Reads the next block of a streamed file into the buffer, first dropping the lines behind the
+  // current position (unless kept); false for a text in memory or at the file's end.
+  bool Refill() {
+    if (file_ == nullptr) return false;
+    if (!keep_ && position_ > 0) {
+      buffer_->erase(0, position_);
+      position_ = 0;
+    }
+    const bool more = file_->Append(buffer_);
+    content_ = *buffer_;
+    return more;
+  }
+
   std::string_view content_;
+  BlockReader* file_ = nullptr;  // the streamed file, or null for a text in memory
+  std::string* buffer_ = nullptr;
+  bool keep_ = false;
   size_t position_ = 0;
   std::string_view line_;
   int64_t line_number_ = 0;
   bool has_newline_ = true;
-  std::string_view first_comment_;
+  std::string first_comment_;  // owned: the buffer it was read from is refilled
 };
 
 // A field is name-like (part of a header row) when it starts with a letter, '_' or a quote.
@@ -280,8 +408,10 @@ Eigen::Quaterniond QuaternionFromRollPitchYaw(double roll, double pitch, double 
 
 class Reader {
  public:
-  Reader(std::string_view content, std::string path)
-      : scanner_(content), content_size_(content.size()), path_(std::move(path)) {}
+  // Reads the rows `scanner` walks; `size` is the text's size in bytes where known (else 0), only to
+  // reserve memory.
+  Reader(LineScanner scanner, uint64_t size, std::string path)
+      : scanner_(std::move(scanner)), content_size_(size), path_(std::move(path)) {}
 
   [[noreturn]] void Fail(int64_t column, const std::string& what) const {
     throw InputError(path_, scanner_.line_number(), column, what);
@@ -497,99 +627,10 @@ class Reader {
   }
 
   LineScanner scanner_;
-  size_t content_size_;
+  uint64_t content_size_;
   std::string path_;
   StampSpan span_;
 };
-
-// "N bytes (X MiB)" for messages about sizes.
-std::string Bytes(uint64_t bytes) {
-  return bytes >= (uint64_t{1} << 30) ? fmt::format("{} bytes ({:.3g} GiB)", bytes, static_cast<double>(bytes) / (1 << 30))
-                                      : fmt::format("{} bytes ({:.3g} MiB)", bytes, static_cast<double>(bytes) / (1 << 20));
-}
-
-// Checks the bytes appended to `content` from `from` on, as they arrive: no NUL byte (a text file
-// has none; /dev/zero and binary files stop at the first chunk) and no line longer than
-// kMaxInputLineBytes. `line_start` (the offset where the current line begins) and `line` (its
-// number) carry over between calls.
-void CheckNewBytes(const std::string& path, std::string_view content, size_t from, size_t* line_start, int64_t* line) {
-  const auto fail_long = [&](size_t length) {
-    throw InputError(path, *line, 1,
-                     fmt::format("no newline in the first {} of this line; expected lines of a trajectory file, at "
-                                 "most {} each",
-                                 Bytes(length), Bytes(kMaxInputLineBytes)));
-  };
-  const size_t nul = content.find('\0', from);
-  const size_t stop = nul == std::string_view::npos ? content.size() : nul;
-  for (size_t i = from; i < stop;) {
-    const void* found = std::memchr(content.data() + i, '\n', stop - i);
-    if (found == nullptr) break;
-    const size_t newline = static_cast<size_t>(static_cast<const char*>(found) - content.data());
-    if (newline - *line_start > kMaxInputLineBytes) fail_long(newline - *line_start);
-    *line_start = newline + 1;
-    ++*line;
-    i = newline + 1;
-  }
-  if (stop - *line_start > kMaxInputLineBytes) fail_long(stop - *line_start);
-  if (nul != std::string_view::npos) {
-    throw InputError(path, *line, static_cast<int64_t>(nul - *line_start) + 1,
-                     "contains a NUL byte (\\0); expected a text file");
-  }
-}
-
-std::string ReadWholeFile(const std::string& path) {
-  if (path.find('\0') != std::string::npos) {
-    throw InputError(QuoteField(path, std::string::npos), 0, 0, "the file name contains a NUL byte (\\0); expected a path");
-  }
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), &std::fclose);
-  if (file == nullptr) {
-    throw InputError(path, 0, 0, fmt::format("cannot open file: {}", std::strerror(errno)));
-  }
-  struct stat status {};
-  if (fstat(fileno(file.get()), &status) != 0) {
-    throw InputError(path, 0, 0, fmt::format("cannot read file: {}", std::strerror(errno)));
-  }
-  if (S_ISDIR(status.st_mode)) throw InputError(path, 0, 0, "is a directory; expected a trajectory file");
-  const uint64_t limit = MaxInputFileBytes();
-  const auto too_large = [&](uint64_t size, const char* what) {
-    return InputError(path, 0, 0,
-                      fmt::format("{} {}; the largest input file read is {} (the smaller of 8 GiB and half the "
-                                  "physical memory)",
-                                  what, Bytes(size), Bytes(limit)));
-  };
-  std::string content;
-  if (S_ISREG(status.st_mode)) {
-    if (static_cast<uint64_t>(status.st_size) > limit) throw too_large(status.st_size, "the file is");
-    content.reserve(static_cast<size_t>(status.st_size));  // one buffer of the file's size, never regrown
-  }
-  // Read in chunks, each checked as it arrives, so that a FIFO, a device or a file without newlines is
-  // refused after at most kMaxInputLineBytes, never read whole into memory first.
-  constexpr size_t kChunk = size_t{1} << 20;
-  size_t line_start = 0;
-  int64_t line = 1;
-  while (true) {
-    const size_t old = content.size();
-    const size_t room = content.capacity() - old;
-    size_t n = 0;
-    if (room == 0) {
-      // Full (a regular file at its end, or a stream): a small read to see whether more follows, so
-      // that the end of a file never doubles its buffer.
-      char probe[4096];
-      n = std::fread(probe, 1, sizeof(probe), file.get());
-      content.append(probe, n);
-    } else {
-      const size_t want = std::min(room, kChunk);
-      content.resize(old + want);
-      n = std::fread(content.data() + old, 1, want, file.get());
-      content.resize(old + n);
-    }
-    if (n == 0) break;
-    CheckNewBytes(path, content, old, &line_start, &line);
-    if (content.size() > limit) throw too_large(content.size(), "the input is more than");
-  }
-  if (std::ferror(file.get())) throw InputError(path, 0, 0, fmt::format("cannot read file: {}", std::strerror(errno)));
-  return content;
-}
 
 bool IsIntegerNanoseconds(std::string_view text) {
   if (text.size() < 13) return false;  // fewer digits cannot be ns since the epoch (1e12 ns = 1000 s)
@@ -618,20 +659,20 @@ std::optional<size_t> FirstNameNotInTumOrder(const std::vector<Field>& header) {
   return std::nullopt;
 }
 
-}  // namespace
-
-Format DetectFormat(const std::string& path, std::string_view content) {
-  LineScanner scanner(content);
+// The format of the text `scanner` walks, from its lines up to the first row of data.
+Format DetectFormatOfLines(const std::string& path, LineScanner& scanner) {
   std::vector<Field> fields;
   bool header = false;
-  std::vector<Field> header_fields;
+  std::string header_text;  // a copy: a streamed line's view ends at the next line
+  char header_separator = ' ';
   int64_t header_line = 0;
   while (scanner.Next()) {
     const char separator = scanner.line().find(',') != std::string_view::npos ? ',' : ' ';
     scanner.Split(separator, &fields);
     if (!header && IsHeaderRow(fields)) {
       header = true;
-      header_fields = fields;
+      header_text = scanner.line();
+      header_separator = separator;
       header_line = scanner.line_number();
       continue;
     }
@@ -651,6 +692,10 @@ Format DetectFormat(const std::string& path, std::string_view content) {
     if (count == 8 || count == 11 || count == 14) {
       const Format format = count == 8 ? Format::kTum : Format::kTumV;
       if (!header) return format;
+      std::vector<Field> header_fields;
+      LineScanner header_row(header_text);
+      header_row.Next();
+      header_row.Split(header_separator, &header_fields);
       // The tum/tumv readers skip a header row, so detection accepts one that names TUM's columns.
       const std::optional<size_t> wrong = FirstNameNotInTumOrder(header_fields);
       if (!wrong && header_fields.size() == count) return format;
@@ -686,10 +731,26 @@ Format DetectFormat(const std::string& path, std::string_view content) {
                    "no poses: expected at least one row of data (the file is empty or only comments)");
 }
 
-Trajectory ParseTrajectory(std::string_view content, const std::string& path, const ReadOptions& options,
-                           Format* format_read) {
+}  // namespace
+
+Format DetectFormat(const std::string& path, std::string_view content) {
+  LineScanner scanner(content);
+  return DetectFormatOfLines(path, scanner);
+}
+
+namespace {
+
+// Reads a trajectory from the lines `scan(keep)` walks from the start of the text: a look at the
+// first data line where the format is detected or the separator probed (`keep`: those lines are
+// read again), then the rows. `size` is the text's size where known (else 0).
+template <typename Scan>
+Trajectory ParseLines(Scan scan, uint64_t size, const std::string& path, const ReadOptions& options,
+                      Format* format_read) {
   Format format = options.format;
-  if (format == Format::kAuto) format = DetectFormat(path, content);
+  if (format == Format::kAuto) {
+    LineScanner probe = scan(true);
+    format = DetectFormatOfLines(path, probe);
+  }
   if (format_read != nullptr) *format_read = format;
   Layout layout;
   switch (format) {
@@ -702,14 +763,14 @@ Trajectory ParseTrajectory(std::string_view content, const std::string& path, co
       if (!options.columns) throw UsageError(
             "ReadOptions::format csv needs ReadOptions::columns (e.g. ReadOptions::columns t,px,py,pz,qx,qy,qz,qw)");
       // The separator is the file's: commas if its first data line has one, else whitespace.
-      LineScanner probe(content);
+      LineScanner probe = scan(true);
       const char separator = probe.Next() && probe.line().find(',') != std::string_view::npos ? ',' : ' ';
       layout = MakeLayout(*options.columns, separator, Format::kCsv);
       break;
     }
     case Format::kAuto: break;
   }
-  Reader reader(content, path);
+  Reader reader(scan(false), size, path);
   Trajectory trajectory = reader.Read(layout);
   if (format == Format::kKitti) {
     if (options.kitti_times_path.empty()) {
@@ -728,6 +789,13 @@ Trajectory ParseTrajectory(std::string_view content, const std::string& path, co
   return trajectory;
 }
 
+}  // namespace
+
+Trajectory ParseTrajectory(std::string_view content, const std::string& path, const ReadOptions& options,
+                           Format* format_read) {
+  return ParseLines([content](bool) { return LineScanner(content); }, content.size(), path, options, format_read);
+}
+
 uint64_t MaxInputFileBytes() {
   static const uint64_t limit = [] {
     const long pages = sysconf(_SC_PHYS_PAGES);
@@ -740,8 +808,7 @@ uint64_t MaxInputFileBytes() {
 
 namespace {
 
-std::vector<int64_t> ParseStamps(std::string_view content, const std::string& path) {
-  LineScanner scanner(content);
+std::vector<int64_t> ParseStamps(LineScanner scanner, const std::string& path) {
   std::vector<Field> fields;
   std::vector<int64_t> stamps;
   StampSpan span;
@@ -779,8 +846,8 @@ auto WithinMemory(const std::string& path, Read read) -> decltype(read()) {
     std::error_code error;
     const uintmax_t size = std::filesystem::file_size(path, error);
     throw InputError(path, 0, 0,
-                     fmt::format("not enough memory to read {}: the text and the poses need about twice its "
-                                 "size; expected a smaller file or more free memory",
+                     fmt::format("not enough memory to read {}: its poses need up to about twice its size; "
+                                 "expected a smaller file or more free memory",
                                  error ? std::string("it") : "the file of " + Bytes(size)));
   }
 }
@@ -793,12 +860,19 @@ Trajectory ReadTrajectory(const std::string& path, const ReadOptions& options, F
       if (format_read != nullptr) *format_read = Format::kAuto;
       return std::move(*recorded);
     }
-    return ParseTrajectory(ReadWholeFile(path), path, options, format_read);
+    BlockReader file(path);
+    std::string buffer;  // the lines not read yet, about one block
+    return ParseLines([&](bool keep) { return LineScanner(&file, &buffer, keep); }, file.size(), path, options,
+                      format_read);
   });
 }
 
 std::vector<int64_t> ReadStampsFile(const std::string& path) {
-  return WithinMemory(path, [&] { return ParseStamps(ReadWholeFile(path), path); });
+  return WithinMemory(path, [&] {
+    BlockReader file(path);
+    std::string buffer;
+    return ParseStamps(LineScanner(&file, &buffer, false), path);
+  });
 }
 
 

@@ -4,12 +4,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <string>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "cheval/common/error.h"
@@ -151,6 +153,64 @@ TEST_F(TempFolder, ALineLongerThanTheLimitIsRefusedWithoutReadingOn) {
 TEST_F(TempFolder, DevZeroIsRefusedAtOnce) {
   // Read whole before: /dev/zero grew to 7.7 GB before anything was said.
   EXPECT_EQ(ReadError("/dev/zero"), "/dev/zero:1:1: error: contains a NUL byte (\\0); expected a text file");
+}
+
+// A file is read a block (1 MiB) at a time and only the lines not read yet are kept. Lines that
+// straddle the blocks, a CRLF split between two blocks and a comment header longer than a block (the
+// format is detected past it) read exactly as the same text parsed whole.
+TEST_F(TempFolder, AFileReadInBlocksReadsAsTheSameTextInMemory) {
+  constexpr size_t kBlock = size_t{1} << 20;
+  std::string text = "#timestamp [ns],p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],q_RS_z []\n";
+  while (text.size() < kBlock + kBlock / 2) text += "# a comment line of the header, read before the format is known\n";
+  for (int64_t i = 0; text.size() < 4 * kBlock; ++i) {
+    // Lines of varying length: the block ends fall at every place of a line.
+    text += fmt::format("{},{},{:.{}f},-3.25,1,0,0,0", 1'403'715'273'262'142'976 + i * 5'000'000, i * 1e-3, 0.5 + i,
+                        static_cast<int>(i % 17));
+    // A CR at the last byte of the third block, its LF at the first byte of the fourth (spaces pad
+    // the line: still 8 fields).
+    const size_t cr = 3 * kBlock - 1;
+    if (text.size() <= cr && text.size() + 200 > cr) {
+      text += std::string(cr - text.size(), ' ') + "\r\n";
+    } else {
+      text += "\n";
+    }
+  }
+  ASSERT_EQ(text.substr(3 * kBlock - 1, 2), "\r\n");
+  const std::string path = Write("blocks.csv", text);
+  Format read_format = Format::kAuto, parsed_format = Format::kAuto;
+  const Trajectory read = ReadTrajectory(path, {}, &read_format);
+  const Trajectory parsed = ParseTrajectory(text, path, {}, &parsed_format);
+  EXPECT_EQ(read_format, Format::kEuroc);
+  EXPECT_EQ(parsed_format, Format::kEuroc);
+  ASSERT_GT(read.size(), 40000);
+  ASSERT_EQ(read.size(), parsed.size());
+  EXPECT_TRUE(std::ranges::equal(read.stamps_ns(), parsed.stamps_ns()));
+  EXPECT_EQ(read.positions(), parsed.positions());
+  EXPECT_EQ(read.View().quaternions(), parsed.View().quaternions());
+}
+
+// Where a line is, and a column in a line that began in the block before, are counted across blocks.
+TEST_F(TempFolder, ErrorsPastTheFirstBlockNameTheirLineAndColumn) {
+  constexpr size_t kBlock = size_t{1} << 20;
+  std::string text;
+  int64_t lines = 0;
+  for (; text.size() + 30 < kBlock; ++lines) text += fmt::format("{}.5 1 2 3 0 0 0 1\n", lines);
+  // The line that straddles the first block's end has a bad field after the end.
+  const std::string straddling = fmt::format("{}.5 1 2 3 0 0 0 1", lines) + std::string(40, ' ') + std::string(30, '1');
+  ASSERT_GT(text.size() + straddling.size() - 30, kBlock);
+  text += straddling + "\n";
+  const std::string path = Write("bad.txt", text);
+  ReadOptions tum;
+  tum.format = Format::kTum;
+  EXPECT_EQ(ReadError(path, tum),
+            fmt::format("{}:{}:{}: error: expected 8 fields (t x y z qx qy qz qw), got 9", path, lines + 1,
+                        straddling.size() - 29));
+  // A NUL byte in the second block, in a line that began in the first.
+  std::string nul = text.substr(0, text.size() - straddling.size() - 1) + straddling;
+  nul[nul.size() - 3] = '\0';
+  const std::string nul_path = Write("nul_later.txt", nul + "\n");
+  EXPECT_EQ(ReadError(nul_path), fmt::format("{}:{}:{}: error: contains a NUL byte (\\0); expected a text file",
+                                             nul_path, lines + 1, straddling.size() - 2));
 }
 
 TEST_F(TempFolder, AFileLargerThanTheLimitIsRefusedBeforeReading) {

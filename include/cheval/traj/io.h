@@ -98,7 +98,7 @@ inline constexpr uint64_t kMaxInputFileBytes = uint64_t{8} << 30;
 inline constexpr size_t kMaxInputLineBytes = size_t{1} << 20;
 
 /// The largest input file the readers accept: the smaller of kMaxInputFileBytes and half the
-/// machine's physical memory (reading needs the text and the poses, about twice the file).
+/// machine's physical memory (the poses read take up to about twice the file's size).
 uint64_t MaxInputFileBytes();
 
 /// Reads a trajectory file. Throws InputError (`path:line:column: error: ...`) on any problem:
@@ -108,7 +108,8 @@ uint64_t MaxInputFileBytes();
 /// stamps spanning more than int64 nanoseconds (traj/validate.h, StampSpan), a file larger than
 /// MaxInputFileBytes(), a line longer than kMaxInputLineBytes, a NUL byte, a path containing a NUL
 /// byte, and a file that does not fit in the memory left (std::bad_alloc while reading). The input is
-/// read in chunks, each checked as it arrives, so a FIFO or device is never read without bound.
+/// read in blocks of 1 MiB, each checked as it arrives, so a FIFO or device is never read without bound,
+/// and only the lines not parsed yet are held, never the whole text.
 /// If `format_read` is given, it receives the format used (the detected one for kAuto).
 Trajectory ReadTrajectory(const std::string& path, const ReadOptions& options = {}, Format* format_read = nullptr);
 
