@@ -227,10 +227,32 @@ int WriteAll(int fd, std::string_view text) {
   return 0;
 }
 
-// Finishes a new file: writes all of `text` unless `error` is set already, flushes it to disk and
-// closes the descriptor in any case; 0 or the first errno.
-int WriteSyncClose(int fd, std::string_view text, int error = 0) {
-  if (error == 0) error = WriteAll(fd, text);
+// Writes the text of `file` to `fd`, whole or piece by piece (OutputFile::write); 0 or the errno of
+// the failure. What `file.write` throws itself is passed on.
+int WriteText(int fd, const OutputFile& file) {
+  if (!file.write) return WriteAll(fd, file.text);
+  struct Failed {
+    int error;
+  };
+  try {
+    file.write([fd](std::string_view piece) {
+      if (const int error = WriteAll(fd, piece); error != 0) throw Failed{error};
+    });
+  } catch (const Failed& failed) {
+    return failed.error;
+  }
+  return 0;
+}
+
+// Finishes a new file: writes the text of `file` unless `error` is set already, flushes it to disk
+// and closes the descriptor in any case (also when `file.write` throws); 0 or the first errno.
+int WriteSyncClose(int fd, const OutputFile& file, int error = 0) {
+  try {
+    if (error == 0) error = WriteText(fd, file);
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
   if (error == 0 && ::fsync(fd) != 0) error = errno;
   if (::close(fd) != 0 && error == 0) error = errno;
   return error;
@@ -257,9 +279,11 @@ void Remove(Staged& staged) {
   staged = {};
 }
 
-// Writes `text` to a new temporary beside `target.path`, flushed, with the old file's mode and owner.
-// Throws OutputError naming `shown` and leaves nothing when it cannot.
-Staged Stage(const std::string& shown, const Resolved& target, std::string_view text) {
+// Writes the text of `file` to a new temporary beside `target.path`, flushed, with the old file's mode
+// and owner. Throws OutputError naming `file.path` (or what `file.write` throws) and leaves nothing
+// when it cannot.
+Staged Stage(const OutputFile& file, const Resolved& target) {
+  const std::string& shown = file.path;
   Staged staged{TemporaryName(target.path, "tmp"), -1};
   staged.slot = Register(staged.temporary, false);  // before it exists: no window without cleanup
   // An existing file's mode is set below; until then only its owner can read the temporary.
@@ -276,7 +300,12 @@ Staged Stage(const std::string& shown, const Resolved& target, std::string_view 
     if (::fchown(fd, target.st.st_uid, target.st.st_gid) != 0) (void)::fchown(fd, static_cast<uid_t>(-1), target.st.st_gid);
     if (::fchmod(fd, target.st.st_mode & 07777) != 0) error = errno;
   }
-  error = WriteSyncClose(fd, text, error);
+  try {
+    error = WriteSyncClose(fd, file, error);
+  } catch (...) {
+    Remove(staged);
+    throw;
+  }
   if (error != 0) {
     Remove(staged);
     CannotWrite(shown, error);
@@ -284,21 +313,27 @@ Staged Stage(const std::string& shown, const Resolved& target, std::string_view 
   return staged;
 }
 
-// Writes `text` in place: to a descriptor of this process or to a FIFO / device opened without
-// creating or truncating. Returns 0 or the errno of the failure.
-int WriteInPlace(const Resolved& target, std::string_view text) {
+// Writes the text of `file` in place: to a descriptor of this process or to a FIFO / device opened
+// without creating or truncating. Returns 0 or the errno of the failure.
+int WriteInPlace(const Resolved& target, const OutputFile& file) {
   if (target.descriptor) {
     // What the program printed through C stdio (or iostreams synchronised with it) comes first.
     if (target.fd == STDOUT_FILENO) std::fflush(stdout);
     if (target.fd == STDERR_FILENO) std::fflush(stderr);
-    return WriteAll(target.fd, text);
+    return WriteText(target.fd, file);
   }
   int fd = -1;
   do {
     fd = ::open(target.path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);  // a FIFO blocks until it has a reader
   } while (fd < 0 && errno == EINTR);
   if (fd < 0) return errno;
-  int error = WriteAll(fd, text);
+  int error = 0;
+  try {
+    error = WriteText(fd, file);
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
   if (::close(fd) != 0 && error == 0) error = errno;
   return error;
 }
@@ -337,11 +372,11 @@ void WriteOutputs(std::span<const OutputFile> files) {
       const Resolved& target = targets[i];
       if (target.error != 0) CannotWrite(files[i].path, target.error);
       if (target.exists && S_ISDIR(target.st.st_mode)) CannotWrite(files[i].path, EISDIR);
-      if (Replaced(target)) staged[i] = Stage(files[i].path, target, files[i].text);
+      if (Replaced(target)) staged[i] = Stage(files[i], target);
     }
     for (size_t i = 0; i < files.size(); ++i) {
       if (Replaced(targets[i])) continue;
-      if (const int error = WriteInPlace(targets[i], files[i].text); error != 0) CannotWrite(files[i].path, error);
+      if (const int error = WriteInPlace(targets[i], files[i]); error != 0) CannotWrite(files[i].path, error);
     }
   } catch (...) {
     remove_all();  // nothing was replaced yet
@@ -447,7 +482,10 @@ StagedFolder::~StagedFolder() {
   Unregister(slot_);
 }
 
-void StagedFolder::Write(const std::string& name, std::string_view text) {
+void StagedFolder::Write(const std::string& name, std::string_view text) { Write(OutputFile{name, text}); }
+
+void StagedFolder::Write(const OutputFile& named) {
+  const std::string& name = named.path;
   const std::string shown = path_ + "/" + name;
   if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos) {
     throw UsageError(fmt::format("StagedFolder::Write: '{}' is not a plain file name", name));
@@ -461,7 +499,7 @@ void StagedFolder::Write(const std::string& name, std::string_view text) {
     CannotWrite(shown, error);
   }
   files_.emplace_back(file, slot);
-  if (const int error = WriteSyncClose(fd, text); error != 0) CannotWrite(shown, error);  // the destructor removes it with the staging folder
+  if (const int error = WriteSyncClose(fd, named); error != 0) CannotWrite(shown, error);  // the destructor removes it with the staging folder
 }
 
 namespace {
@@ -525,7 +563,7 @@ void StagedFolder::Publish(FolderExisting existing) {
 
 void WriteFolder(const std::string& path, std::span<const OutputFile> files, FolderExisting existing) {
   StagedFolder folder(path);
-  for (const OutputFile& file : files) folder.Write(file.path, file.text);
+  for (const OutputFile& file : files) folder.Write(file);
   folder.Publish(existing);
 }
 

@@ -1,4 +1,5 @@
 // Trajectory writers and atomic file output.
+#include <algorithm>
 #include <span>
 #include <vector>
 
@@ -35,9 +36,9 @@ void RequireOrientation(const TrajectoryView& trajectory, Format format) {
   }
 }
 
-}  // namespace
-
-std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
+// Throws what FormatTrajectory documents for a trajectory that `format` cannot hold or that would not
+// read back, before any text is made.
+void CheckWritable(const TrajectoryView& trajectory, Format format) {
   // Only what the readers read back: a file with a NaN, a zero quaternion, stamps beyond int64's
   // span or no pose at all would be refused by ReadTrajectory, so it is not written.
   if (trajectory.empty()) {
@@ -48,22 +49,32 @@ std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
     throw ComputeError(fmt::format("cannot write {}: row {}: {} (the file would not read back)", ToString(format),
                                    problem->row, problem->what));
   }
-  // Formatted straight into the string that is returned (no copy of the whole text at the end),
-  // reserved once for the longest possible lines (a shortest round-trip double has at most 24
-  // characters, a stamp at most 21) so that it is never regrown: each regrowth copies the text.
-  std::string out;
-  const size_t values_per_line = 1 + 12 + (trajectory.has_velocity() ? 3 : 0) + (trajectory.has_angular_velocity() ? 3 : 0);
-  out.reserve(static_cast<size_t>(trajectory.size()) * values_per_line * 25 + 256);
+  switch (format) {
+    case Format::kTum:
+    case Format::kEuroc:
+    case Format::kKitti:
+      RequireOrientation(trajectory, format);
+      return;
+    case Format::kTumV:
+      RequireOrientation(trajectory, format);
+      if (!trajectory.has_velocity()) {
+        throw ComputeError("cannot write tumv: the trajectory has no velocity (use `cheval velocity` to add it)");
+      }
+      return;
+    default:
+      throw UsageError(fmt::format("cannot write format '{}'; expected tum, tumv, euroc or kitti", ToString(format)));
+  }
+}
+
+// Appends the lines of rows [begin, end) to `out` (EuRoC's header before row 0); CheckWritable first.
+void AppendRows(const TrajectoryView& trajectory, Format format, Eigen::Index begin, Eigen::Index end,
+                std::string& out) {
   auto it = std::back_inserter(out);
   const auto p = trajectory.positions();
   switch (format) {
     case Format::kTum:
-    case Format::kTumV: {
-      RequireOrientation(trajectory, format);
-      if (format == Format::kTumV && !trajectory.has_velocity()) {
-        throw ComputeError("cannot write tumv: the trajectory has no velocity (use `cheval velocity` to add it)");
-      }
-      for (Eigen::Index i = 0; i < trajectory.size(); ++i) {
+    case Format::kTumV:
+      for (Eigen::Index i = begin; i < end; ++i) {
         const Eigen::Vector4d q = QuaternionAsStored(trajectory, i);
         // Compiled format strings: parsing "{}" at run time per value cost as much as the digits.
         AppendSeconds(out, trajectory.stamps_ns()[i]);
@@ -78,17 +89,17 @@ std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
         }
         out.push_back('\n');
       }
-      break;
-    }
-    case Format::kEuroc: {
-      RequireOrientation(trajectory, format);
-      fmt::format_to(it, "#timestamp [ns],p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],"
-                         "q_RS_z []");
-      if (trajectory.has_velocity()) {
-        fmt::format_to(it, ",v_RS_R_x [m s^-1],v_RS_R_y [m s^-1],v_RS_R_z [m s^-1]");
+      return;
+    case Format::kEuroc:
+      if (begin == 0) {
+        fmt::format_to(it, "#timestamp [ns],p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],"
+                           "q_RS_z []");
+        if (trajectory.has_velocity()) {
+          fmt::format_to(it, ",v_RS_R_x [m s^-1],v_RS_R_y [m s^-1],v_RS_R_z [m s^-1]");
+        }
+        out.push_back('\n');
       }
-      out.push_back('\n');
-      for (Eigen::Index i = 0; i < trajectory.size(); ++i) {
+      for (Eigen::Index i = begin; i < end; ++i) {
         const Eigen::Vector4d q = QuaternionAsStored(trajectory, i);
         fmt::format_to(it, FMT_COMPILE("{},{},{},{},{},{},{},{}"), trajectory.stamps_ns()[i], p(0, i), p(1, i), p(2, i), q[3],
                        q[0], q[1], q[2]);
@@ -98,20 +109,50 @@ std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
         }
         out.push_back('\n');
       }
-      break;
-    }
-    case Format::kKitti: {
-      RequireOrientation(trajectory, format);
-      for (Eigen::Index i = 0; i < trajectory.size(); ++i) {
+      return;
+    case Format::kKitti:
+      for (Eigen::Index i = begin; i < end; ++i) {
         const Eigen::Matrix3d R = trajectory.Rotation(i);
         fmt::format_to(it, FMT_COMPILE("{} {} {} {} {} {} {} {} {} {} {} {}\n"), R(0, 0), R(0, 1), R(0, 2), p(0, i), R(1, 0),
                        R(1, 1), R(1, 2), p(1, i), R(2, 0), R(2, 1), R(2, 2), p(2, i));
       }
-      break;
-    }
+      return;
     default:
-      throw UsageError(fmt::format("cannot write format '{}'; expected tum, tumv, euroc or kitti", ToString(format)));
+      return;  // refused by CheckWritable
   }
+}
+
+// The longest line of `trajectory` in any format: a shortest round-trip double has at most 24
+// characters, a stamp at most 21.
+size_t LongestLine(const TrajectoryView& trajectory) {
+  const size_t values = 1 + 12 + (trajectory.has_velocity() ? 3 : 0) + (trajectory.has_angular_velocity() ? 3 : 0);
+  return values * 25;
+}
+
+}  // namespace
+
+void FormatTrajectory(const TrajectoryView& trajectory, Format format,
+                      const std::function<void(std::string_view)>& sink) {
+  CheckWritable(trajectory, format);
+  // Rows are formatted into one block of about kBlockBytes, reused, and handed over block by block.
+  constexpr size_t kBlockBytes = size_t{1} << 20;
+  const Eigen::Index rows = static_cast<Eigen::Index>(std::max<size_t>(1, kBlockBytes / LongestLine(trajectory)));
+  std::string block;
+  block.reserve(static_cast<size_t>(rows) * LongestLine(trajectory) + 256);
+  for (Eigen::Index begin = 0; begin < trajectory.size(); begin += rows) {
+    block.clear();
+    AppendRows(trajectory, format, begin, std::min(trajectory.size(), begin + rows), block);
+    sink(block);
+  }
+}
+
+std::string FormatTrajectory(const TrajectoryView& trajectory, Format format) {
+  CheckWritable(trajectory, format);
+  // Formatted straight into the string that is returned, reserved once for the longest possible
+  // lines so that it is never regrown: each regrowth copies the text.
+  std::string out;
+  out.reserve(static_cast<size_t>(trajectory.size()) * LongestLine(trajectory) + 256);
+  AppendRows(trajectory, format, 0, trajectory.size(), out);
   return out;
 }
 
@@ -119,7 +160,8 @@ void WriteTrajectory(const std::string& path, const TrajectoryView& trajectory, 
   if (path.find('\0') != std::string::npos) {
     throw UsageError(fmt::format("{}: the file name contains a NUL byte (\\0); expected a path", QuoteField(path, std::string::npos)));
   }
-  WriteOutput(path, FormatTrajectory(trajectory, format));
+  const OutputFile file{path, [&](const TextSink& sink) { FormatTrajectory(trajectory, format, sink); }};
+  WriteOutputs(std::span<const OutputFile>(&file, 1));
 }
 
 }  // namespace cheval::traj

@@ -47,14 +47,16 @@ void RegisterConvert(CLI::App& app, Action* action) {
       RefuseSharedPaths({flags->input, flags->format.kitti_times},
                         {{"-o", flags->output}, {"--times-output", flags->times_output}});
       const traj::Trajectory trajectory = traj::ReadTrajectory(flags->input, flags->format.ToReadOptions());
-      // Everything is formatted before anything is written, so an error leaves no file behind.
-      const std::string text = traj::FormatTrajectory(trajectory.View(), to);
       std::string times;
       if (!flags->times_output.empty()) {
         if (!trajectory.channels().has_stamps) throw ComputeError("--times-output: the input has no stamps");
         for (int64_t stamp : trajectory.stamps_ns()) times += traj::FormatSeconds(stamp) + "\n";
       }
-      std::vector<OutputFile> files{{flags->output, text}};
+      // Formatted a block at a time as it is written; a file is replaced only when whole, and
+      // FormatTrajectory checks everything before its first block, so an error leaves no file behind.
+      std::vector<OutputFile> files{{flags->output, [&](const TextSink& sink) {
+                                       traj::FormatTrajectory(trajectory.View(), to, sink);
+                                     }}};
       if (!times.empty()) files.push_back({flags->times_output, times});
       WriteOutputs(files);
       if (!Quiet()) fmt::print(stderr, "wrote {} poses to {} ({})\n", trajectory.size(), flags->output, traj::ToString(to));

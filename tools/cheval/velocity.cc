@@ -66,10 +66,8 @@ void Run(const VelocityFlags& flags) {
                                    "left out)",
                                    flags.at_path, at->size(), flags.input));
   }
-  const std::string text =
-      flags.output.empty()
-          ? ""
-          : traj::FormatTrajectory(eval::VelocityTrajectory(view, estimate, at_span).View(), traj::Format::kTumV);
+  std::optional<traj::Trajectory> out;  // formatted a block at a time as it is written
+  if (!flags.output.empty()) out = eval::VelocityTrajectory(view, estimate, at_span);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::string json = eval::VelocityJson(
       {flags.input, view.size(), options, at ? at->size() - estimate.skipped.size() : static_cast<size_t>(view.size()),
@@ -88,7 +86,11 @@ void Run(const VelocityFlags& flags) {
                whole, nanoseconds);
   }
   std::vector<OutputFile> files;
-  if (!flags.output.empty()) files.push_back({flags.output, text});
+  if (out) {
+    files.push_back({flags.output, [&out](const TextSink& sink) {
+                       traj::FormatTrajectory(out->View(), traj::Format::kTumV, sink);
+                     }});
+  }
   if (!flags.json_path.empty()) files.push_back({flags.json_path, json});
   WriteOutputs(files);
   if (!estimate.curve) {

@@ -9,6 +9,7 @@
 /// Messages name the path as the caller gave it; standard output is named `<stdout>`
 /// ("<stdout>: error: cannot write: No space left on device").
 
+#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -20,10 +21,24 @@ namespace cheval {
 /// The path that names standard output (file descriptor 1).
 inline constexpr std::string_view kStandardOutput = "-";
 
-/// One output of WriteOutputs: where, and the whole text.
+/// Receives an output's text a piece at a time (OutputFile::write).
+using TextSink = std::function<void(std::string_view piece)>;
+
+/// One output of WriteOutputs: where, and the whole text, or a function that writes it a piece at a
+/// time, so that a large output is never held whole in memory.
 struct OutputFile {
+  /// The whole text, held by the caller until the output is written.
+  OutputFile(std::string where, std::string_view whole) : path(std::move(where)), text(whole) {}
+  /// The text written by `write`, called once with a sink that writes each piece it is given (and
+  /// throws to stop it when a write fails). What `write` throws is passed on, as any failure, with
+  /// nothing replaced; but an output written in place (standard output, a FIFO) cannot take back the
+  /// pieces already given, so `write` should check everything before its first piece.
+  OutputFile(std::string where, std::function<void(const TextSink& sink)> pieces)
+      : path(std::move(where)), write(std::move(pieces)) {}
+
   std::string path;
   std::string_view text;
+  std::function<void(const TextSink& sink)> write;  ///< when set, used instead of `text`
 };
 
 /// Writes several outputs as one. Each path is resolved first:
@@ -96,6 +111,8 @@ class StagedFolder {
   /// Writes file `name` (a plain name, no `/`) into the staging folder, flushed to disk. Throws
   /// OutputError "PATH/NAME: error: cannot write: ..." (the staging folder stays until destruction).
   void Write(const std::string& name, std::string_view text);
+  /// Write() of `file.path` (a plain name) with its text, or piece by piece (OutputFile::write).
+  void Write(const OutputFile& file);
 
   /// Renames the staging folder into place. A missing target or an empty folder is replaced by one
   /// rename. A non-empty folder is refused (OutputError, kRefuse) or replaced (kReplace): the two are

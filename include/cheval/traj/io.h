@@ -18,6 +18,7 @@
 /// `path:line:column`.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -129,7 +130,12 @@ std::vector<int64_t> ReadStampsFile(const std::string& path);
 /// that whatever is written reads back; UsageError for a format that cannot be written.
 std::string FormatTrajectory(const TrajectoryView& trajectory, Format format);
 
-/// Writes FormatTrajectory() to `path` atomically: a temporary file beside it is written, flushed
+/// FormatTrajectory's text handed to `sink` a block of about 1 MiB at a time, for an output too large
+/// to hold whole (OutputFile::write). Every check is made, and throws, before the first block.
+void FormatTrajectory(const TrajectoryView& trajectory, Format format,
+                      const std::function<void(std::string_view)>& sink);
+
+/// Writes FormatTrajectory() to `path`, a block at a time, atomically: a temporary file beside it is written, flushed
 /// and renamed, so a failure leaves no partial file. `-`, a FIFO or a device is written in place and a
 /// symlink's target is replaced (cheval/common/output.h, WriteOutputs). Throws OutputError.
 void WriteTrajectory(const std::string& path, const TrajectoryView& trajectory, Format format);
