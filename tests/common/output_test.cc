@@ -127,6 +127,42 @@ TEST_F(OutputTest, SeveralOutputsAreWrittenAllOrNothing) {
   EXPECT_EQ(entries, 2u);  // a.txt and b.txt: no temporary is left behind
 }
 
+// An output written a piece at a time: the pieces in order; what its function throws, and a write that
+// fails part way, replace nothing and leave no temporary; the function stops at the failed write.
+TEST_F(OutputTest, PiecewiseOutputsKeepTheAllOrNothingContract) {
+  const std::string a = Path("a.txt"), b = Path("b.txt");
+  const auto pieces = [](int count) {
+    return [count](const TextSink& sink) {
+      for (int i = 0; i < count; ++i) sink(std::to_string(i) + "\n");
+    };
+  };
+  WriteOutputs(std::vector<OutputFile>{{a, pieces(3)}, {b, "whole\n"}});
+  EXPECT_EQ(ReadWhole(a), "0\n1\n2\n");
+  EXPECT_EQ(ReadWhole(b), "whole\n");
+
+  // The function throws after two pieces: both files keep their old text.
+  const std::vector<OutputFile> throwing{{b, "replaced\n"}, {a, [](const TextSink& sink) {
+                                            sink("0\n");
+                                            sink("1\n");
+                                            throw ComputeError("row 2: not a number");
+                                          }}};
+  EXPECT_EQ(MessageOf<ComputeError>([&] { WriteOutputs(throwing); }), "row 2: not a number");
+  EXPECT_EQ(ReadWhole(a), "0\n1\n2\n");
+  EXPECT_EQ(ReadWhole(b), "whole\n");
+  EXPECT_TRUE(Temporaries().empty());
+
+  // A device that fails the first write: an OutputError, the function is not called again.
+  int calls = 0;
+  const std::vector<OutputFile> full{{b, "replaced\n"}, {"/dev/full", [&calls](const TextSink& sink) {
+                                        for (int i = 0; i < 100; ++i, ++calls) sink("piece\n");
+                                      }}};
+  EXPECT_EQ(MessageOf<OutputError>([&] { WriteOutputs(full); }),
+            std::string("/dev/full: error: cannot write: ") + std::strerror(ENOSPC));
+  EXPECT_EQ(calls, 0);
+  EXPECT_EQ(ReadWhole(b), "whole\n");
+  EXPECT_TRUE(Temporaries().empty());
+}
+
 TEST_F(OutputTest, NewFileGetsTheUmaskMode) {
   const mode_t mask = ::umask(0);
   ::umask(mask);

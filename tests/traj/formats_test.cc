@@ -89,6 +89,32 @@ TEST(Formats, WriterRefusesWhatTheFormatCannotHold) {
   EXPECT_THROW(FormatTrajectory(no_velocity.View(), Format::kVins), UsageError);
 }
 
+// The writers' blocks (about 1 MiB each, for outputs too large to hold whole) join to the text that
+// FormatTrajectory returns, in every format; a trajectory a format cannot hold throws before the
+// first block.
+TEST(Formats, BlocksJoinToTheWholeText) {
+  sim::MotionOptions options;
+  options.duration_s = 120.0;
+  options.rate_hz = 100.0;  // 12001 poses: several blocks in every format
+  Trajectory truth = sim::GenerateMotion(options);
+  for (const Format format : {Format::kTum, Format::kTumV, Format::kEuroc, Format::kKitti}) {
+    std::string joined;
+    int blocks = 0;
+    FormatTrajectory(truth.View(), format, [&](std::string_view block) {
+      EXPECT_FALSE(block.empty());
+      EXPECT_EQ(block.back(), '\n');  // whole lines only
+      joined += block;
+      ++blocks;
+    });
+    EXPECT_GT(blocks, 1) << ToString(format);
+    EXPECT_EQ(joined, FormatTrajectory(truth.View(), format)) << ToString(format);
+  }
+  const Trajectory no_velocity = ParseTrajectory("1 0 0 0 0 0 0 1\n2 0 0 0 0 0 0 1\n", "m.txt");
+  int pieces = 0;
+  EXPECT_THROW(FormatTrajectory(no_velocity.View(), Format::kTumV, [&](std::string_view) { ++pieces; }), ComputeError);
+  EXPECT_EQ(pieces, 0);
+}
+
 TEST(Detect, ByContent) {
   EXPECT_EQ(DetectFormat("a", "# c\n1 0 0 0 0 0 0 1\n"), Format::kTum);
   EXPECT_EQ(DetectFormat("a", "1\t0  0 0 0 0 0 1 4 5 6\n"), Format::kTumV);
