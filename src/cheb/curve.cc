@@ -539,10 +539,13 @@ class WindowFitter {
   }
 
   // The normal equations of each cross-validation fold (sample i in fold i mod kFolds) of the
-  // samples centred on their mean, with Σz² per fold, and their sum.
+  // samples centred on their mean, with Σz² per fold, and their sum. The folds keep their sums
+  // only (NormalMoments), and a fold's matrix is built when it is held out: five matrices of
+  // degree 400 held at once per thread were a fifth of a long recording's memory, each page of it
+  // first touched at ~10 µs (docs/velocity.md, "Speed").
   static constexpr int kFolds = 5;
   struct Folds {
-    std::vector<NormalEquations> parts;
+    std::vector<NormalMoments> parts;
     std::vector<Eigen::RowVectorXd> squares;
     NormalEquations total;
     Eigen::RowVectorXd mean;
@@ -571,12 +574,12 @@ class WindowFitter {
       }
       // A fold may have fewer samples than top + 1: its own system is then singular, which is fine
       // (only sums and products of it are used), so build it without the sample-count check.
-      NormalEquations normal = BuildNormalEquationsUnchecked(ft, fz, top, interval);
+      NormalMoments normal = BuildNormalMomentsUnchecked(ft, fz, top, interval);
       folds.squares.push_back(fz.colwise().squaredNorm());
       if (fold == 0) {
-        folds.total = normal;
+        folds.total = normal.Equations();
       } else {
-        folds.total.gram += normal.gram;
+        folds.total.gram += normal.Gram();
         folds.total.rhs += normal.rhs;
         folds.total.samples += normal.samples;
       }
@@ -623,7 +626,7 @@ class WindowFitter {
     const Eigen::Index d = folds.total.rhs.cols();
     Eigen::MatrixXd error = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(grid.size()), d);
     for (int fold = 0; fold < kFolds; ++fold) {
-      const NormalEquations& held_out = folds.parts[fold];
+      const NormalEquations held_out = folds.parts[fold].Equations();
       NormalEquations train = folds.total;
       train.gram -= held_out.gram;
       train.rhs -= held_out.rhs;
