@@ -1015,16 +1015,19 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   // Jumps and glitches (CurveOptions::robust): outliers leave the fit, jumps split it.
   internal::Jumps jumps;
   Eigen::VectorXd noise;  // of the samples split at the gaps
-  std::optional<internal::DifferenceMagnitudes> magnitudes;  // of the samples fitted, for their noise profile
   // The noise profile before the search (its jumps and glitches read as noise there too) floors
   // the search's scale where the samples are noisier: against the recording's σ a burst's slopes
   // were taken for jumps. Where the search finds nothing, it is the fit's profile as well.
   std::optional<internal::NoiseProfile> before;
   if (options.robust) {
+    // The differences go before the search, which needs only the profile: they take 96 bytes a
+    // sample, and a page first touched costs ~10 µs (docs/velocity.md, "Speed").
+    std::optional<internal::DifferenceMagnitudes> magnitudes;
     if (!options.noise_sigma) magnitudes.emplace(t, z, gaps, threads);
     noise = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
                                 : floored(magnitudes->Sigma(0, m));
     if (magnitudes) before.emplace(noise, *magnitudes, m);
+    magnitudes.reset();
     jumps = internal::FindJumps(t, z, gaps, noise, before ? &*before : nullptr, threads);
   }
   std::vector<char> kept(static_cast<size_t>(m), 1);
@@ -1087,7 +1090,8 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
 
   // Taken again where the search found something (fewer samples, steps out, more cuts).
   const bool found = !jumps.outliers.empty() || !jumps.steps.empty() || !jumps.breaks.empty();
-  if (!options.noise_sigma && (found || !magnitudes)) magnitudes.emplace(t, z, cuts, threads);
+  std::optional<internal::DifferenceMagnitudes> magnitudes;  // of the samples fitted, for their noise profile
+  if (!options.noise_sigma && (found || !before)) magnitudes.emplace(t, z, cuts, threads);
   curve.noise_sigma_ = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
                        : noise.size() > 0 && !found ? noise
                                                     : floored(magnitudes->Sigma(0, fitted_count));

@@ -308,15 +308,23 @@ Eigen::VectorXd DifferenceMagnitudes::Estimate(Eigen::Index begin, Eigen::Index 
   return sigma;
 }
 
-Eigen::MatrixXi DifferenceMagnitudes::CountsAbove(const Eigen::VectorXd& threshold) const {
-  const Eigen::Index m = fourth_.rows(), d = fourth_.cols();
-  Eigen::MatrixXi counts = Eigen::MatrixXi::Zero(m + 1, 2 * d);
+Eigen::MatrixXi DifferenceMagnitudes::CountsAbove(const Eigen::VectorXd& threshold, Eigen::Index stride) const {
+  if (stride < 1) throw std::invalid_argument("DifferenceMagnitudes::CountsAbove: stride below 1");
+  const Eigen::Index m = fourth_.rows(), d = fourth_.cols(), rows = (m + stride - 1) / stride + 1;
+  Eigen::MatrixXi counts = Eigen::MatrixXi::Zero(rows, 2 * d);
   for (Eigen::Index c = 0; c < d; ++c) {
+    int usable = 0, above = 0;
     for (Eigen::Index i = 0; i < m; ++i) {
       const double v = fourth_(i, c);
-      const bool usable = !std::isnan(v);
-      counts(i + 1, 2 * c) = counts(i, 2 * c) + (usable ? 1 : 0);
-      counts(i + 1, 2 * c + 1) = counts(i, 2 * c + 1) + (usable && kMadScale * v > threshold[c] ? 1 : 0);
+      if (!std::isnan(v)) {
+        ++usable;
+        if (kMadScale * v > threshold[c]) ++above;
+      }
+      if ((i + 1) % stride == 0 || i + 1 == m) {
+        const Eigen::Index row = (i + stride) / stride;  // ⌈(i + 1) / stride⌉
+        counts(row, 2 * c) = usable;
+        counts(row, 2 * c + 1) = above;
+      }
     }
   }
   return counts;

@@ -232,12 +232,16 @@ NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitu
   // Where the 4th differences' median over a stretch cannot exceed a threshold (their counts say
   // so), no median is taken; a threshold that varies along the samples is not counted.
   Eigen::MatrixXi counts, burst_counts;
-  if (base.size() == 0) counts = magnitudes.CountsAbove(raise), burst_counts = magnitudes.CountsAbove(burst);
-  auto may_exceed = [d](const Eigen::MatrixXi& above_counts, Eigen::Index from, Eigen::Index to) {
+  if (base.size() == 0) {
+    counts = magnitudes.CountsAbove(raise, kBlock), burst_counts = magnitudes.CountsAbove(burst, kBlock);
+  }
+  // Stretches start and end at blocks' starts or at the end: rows of the counts.
+  auto row = [](Eigen::Index sample) { return (sample + kBlock - 1) / kBlock; };
+  auto may_exceed = [d, &row](const Eigen::MatrixXi& above_counts, Eigen::Index from, Eigen::Index to) {
     if (above_counts.size() == 0) return true;
     for (Eigen::Index c = 0; c < d; ++c) {
-      const int usable = above_counts(to, 2 * c) - above_counts(from, 2 * c);
-      const int above = above_counts(to, 2 * c + 1) - above_counts(from, 2 * c + 1);
+      const int usable = above_counts(row(to), 2 * c) - above_counts(row(from), 2 * c);
+      const int above = above_counts(row(to), 2 * c + 1) - above_counts(row(from), 2 * c + 1);
       if (usable > 0 && above >= usable - usable / 2) return true;
     }
     return false;

@@ -35,12 +35,13 @@ class DifferenceMagnitudes {
   /// larger than `threshold`: the 4th differences' estimate, which the higher orders only ever
   /// lower. A third of the cost where a stretch is not noisier.
   Eigen::VectorXd SigmaIfAbove(Eigen::Index begin, Eigen::Index end, const Eigen::VectorXd& threshold) const;
-  /// For telling where SigmaIfAbove can exceed `threshold` without a median: per coordinate c, the
-  /// number of usable runs starting before each sample (column 2c) and of those whose 4th
-  /// differences' scaled magnitude exceeds threshold[c] (column 2c + 1), (m + 1) x 2d. Over a
-  /// stretch of n usable runs, the 4th differences' estimate exceeds the threshold exactly when
-  /// n − ⌊n/2⌋ of them do.
-  Eigen::MatrixXi CountsAbove(const Eigen::VectorXd& threshold) const;
+  /// For telling where SigmaIfAbove can exceed `threshold` without a median, over stretches that
+  /// start and end at multiples of `stride` (or at the last sample): per coordinate c, the number
+  /// of usable runs starting before sample k·stride (row k; the last row: before the end, m) in
+  /// column 2c, and of those whose 4th differences' scaled magnitude exceeds threshold[c] in
+  /// column 2c + 1; ⌈m / stride⌉ + 1 rows x 2d. Over a stretch of n usable runs, the 4th
+  /// differences' estimate exceeds the threshold exactly when n − ⌊n/2⌋ of them do.
+  Eigen::MatrixXi CountsAbove(const Eigen::VectorXd& threshold, Eigen::Index stride) const;
 
   /// The magnitudes of the 4th and 8th divided differences by run start (m x d, NaN where no usable
   /// run starts; kMadScale times their median is σ).
