@@ -59,6 +59,8 @@ constexpr double kEndHoleRatio = 2.5;
 constexpr Eigen::Index kParallelSamples = 2000;
 // Curve::EvaluateMany splits at least this many queries over the curve's threads.
 constexpr Eigen::Index kParallelQueries = 8192;
+// Curve::EvaluateMany's queries per block of scratch.
+constexpr Eigen::Index kEvaluationBlock = 4096;
 // End windows are halved (RefineEnds) while they keep this many samples on each side.
 constexpr Eigen::Index kMinEndWindowSamples = 24;
 using internal::kLackOfFitLimit;
@@ -1480,66 +1482,71 @@ void Curve::EvaluateMany(std::span<const int64_t> stamps_ns, int order, Eigen::M
   values->resize(n, d);
   if (order >= 1) first->resize(n, d);
   if (order >= 2) second->resize(n, d);
-  // The queries sorted[r0..r1) (each writes its own rows only).
+  // The queries sorted[r0..r1) (each writes its own rows only), a block of at most
+  // kEvaluationBlock at a time through the same scratch (about 150 bytes a query: the many
+  // queries of a long recording at once took a third of its memory).
   auto evaluate = [&](Eigen::Index r0, Eigen::Index r1) {
-    const Eigen::Index count = r1 - r0;
-    std::vector<double> t(static_cast<size_t>(count));
-    std::vector<Placement> placements(static_cast<size_t>(count));
+    const Eigen::Index capacity = std::min(r1 - r0, kEvaluationBlock);
+    std::vector<double> t(static_cast<size_t>(capacity));
+    std::vector<Placement> placements(static_cast<size_t>(capacity));
     // A query inside a local run is the run's (no window is evaluated for it).
-    std::vector<const LocalRun*> local(static_cast<size_t>(count));
-    for (Eigen::Index r = 0; r < count; ++r) {
-      t[r] = static_cast<double>(stamps_ns[sorted[r0 + r]] - origin_ns_) * 1e-9;
-      local[r] = LocalRunAt(t[r]);
-      if (local[r] == nullptr) placements[r] = Locate(t[r], tolerance_s);
-    }
+    std::vector<const LocalRun*> local(static_cast<size_t>(capacity));
     // Each window evaluated at a run of queries at once (vectorised Clenshaw), for the left and
     // the right window of every query: (order + 1) blocks of count x d each.
     std::array<Eigen::MatrixXd, 3> left, right;
     for (int k = 0; k <= order; ++k) {
-      left[k].resize(count, d);
-      right[k].resize(count, d);
+      left[k].resize(capacity, d);
+      right[k].resize(capacity, d);
     }
-    auto evaluate_runs = [&](bool use_right, std::array<Eigen::MatrixXd, 3>& out) {
-      for (Eigen::Index begin = 0; begin < count;) {
-        const CurveWindow* w = use_right ? placements[begin].right : placements[begin].left;
-        Eigen::Index end = begin + 1;
-        while (end < count && (use_right ? placements[end].right : placements[end].left) == w) ++end;
-        if (w != nullptr) {
-          const Eigen::Map<const Eigen::VectorXd> times(t.data() + begin, end - begin);
-          for (int k = 0; k <= order; ++k) out[k].middleRows(begin, end - begin) = internal::WindowSeriesAt(*w, times, k);
+    for (Eigen::Index b0 = r0; b0 < r1; b0 += capacity) {
+      const Eigen::Index count = std::min(capacity, r1 - b0);
+      for (Eigen::Index r = 0; r < count; ++r) {
+        t[r] = static_cast<double>(stamps_ns[sorted[b0 + r]] - origin_ns_) * 1e-9;
+        local[r] = LocalRunAt(t[r]);
+        placements[r] = local[r] == nullptr ? Locate(t[r], tolerance_s) : Placement{};
+      }
+      auto evaluate_runs = [&](bool use_right, std::array<Eigen::MatrixXd, 3>& out) {
+        for (Eigen::Index begin = 0; begin < count;) {
+          const CurveWindow* w = use_right ? placements[begin].right : placements[begin].left;
+          Eigen::Index end = begin + 1;
+          while (end < count && (use_right ? placements[end].right : placements[end].left) == w) ++end;
+          if (w != nullptr) {
+            const Eigen::Map<const Eigen::VectorXd> times(t.data() + begin, end - begin);
+            for (int k = 0; k <= order; ++k) out[k].middleRows(begin, end - begin) = internal::WindowSeriesAt(*w, times, k);
+          }
+          begin = end;
         }
-        begin = end;
-      }
-    };
-    evaluate_runs(false, left);
-    evaluate_runs(true, right);
-    for (Eigen::Index r = 0; r < count; ++r) {
-      const Placement& q = placements[r];
-      const Eigen::Index i = sorted[r0 + r];
-      if (local[r] != nullptr) {
-        Eigen::RowVectorXd p(d), v(d), a(d);
-        EvaluateLocal(*local[r], t[r], order, p, v, a);
-        values->row(i) = p;
+      };
+      evaluate_runs(false, left);
+      evaluate_runs(true, right);
+      for (Eigen::Index r = 0; r < count; ++r) {
+        const Placement& q = placements[r];
+        const Eigen::Index i = sorted[b0 + r];
+        if (local[r] != nullptr) {
+          Eigen::RowVectorXd p(d), v(d), a(d);
+          EvaluateLocal(*local[r], t[r], order, p, v, a);
+          values->row(i) = p;
+          AddSteps(t[r], values->row(i));
+          if (order >= 1) first->row(i) = v;
+          if (order >= 2) second->row(i) = a;
+          continue;
+        }
+        if (q.right == nullptr) {
+          values->row(i) = left[0].row(r);
+          AddSteps(t[r], values->row(i));
+          if (order >= 1) first->row(i) = left[1].row(r);
+          if (order >= 2) second->row(i) = left[2].row(r);
+          continue;
+        }
+        const double s = q.s, ds = q.ds, dds = q.dds;
+        const auto dp = right[0].row(r) - left[0].row(r);
+        values->row(i) = (1.0 - s) * left[0].row(r) + s * right[0].row(r);
         AddSteps(t[r], values->row(i));
-        if (order >= 1) first->row(i) = v;
-        if (order >= 2) second->row(i) = a;
-        continue;
-      }
-      if (q.right == nullptr) {
-        values->row(i) = left[0].row(r);
-        AddSteps(t[r], values->row(i));
-        if (order >= 1) first->row(i) = left[1].row(r);
-        if (order >= 2) second->row(i) = left[2].row(r);
-        continue;
-      }
-      const double s = q.s, ds = q.ds, dds = q.dds;
-      const auto dp = right[0].row(r) - left[0].row(r);
-      values->row(i) = (1.0 - s) * left[0].row(r) + s * right[0].row(r);
-      AddSteps(t[r], values->row(i));
-      if (order >= 1) first->row(i) = (1.0 - s) * left[1].row(r) + s * right[1].row(r) + ds * dp;
-      if (order >= 2) {
-        second->row(i) = (1.0 - s) * left[2].row(r) + s * right[2].row(r) +
-                         2.0 * ds * (right[1].row(r) - left[1].row(r)) + dds * dp;
+        if (order >= 1) first->row(i) = (1.0 - s) * left[1].row(r) + s * right[1].row(r) + ds * dp;
+        if (order >= 2) {
+          second->row(i) = (1.0 - s) * left[2].row(r) + s * right[2].row(r) +
+                           2.0 * ds * (right[1].row(r) - left[1].row(r)) + dds * dp;
+        }
       }
     }
   };
