@@ -172,6 +172,39 @@ TEST(BuildNormalEquations, UnweightedKernelIsBitIdenticalToUnitWeights) {
   }
 }
 
+// Normal equations kept by their sums build the same matrix, bit for bit, and the same
+// right-hand side: the cross-validation's folds are kept that way, and their sums must be the
+// matrices they replace.
+TEST(NormalMoments, BuildExactlyTheNormalEquations) {
+  std::mt19937_64 rng(8);
+  std::normal_distribution<double> normal;
+  std::uniform_real_distribution<double> uniform(0.5, 2.0);
+  for (const int top : {0, 1, 2, 9, 40}) {
+    const int m = 200, d = 3;
+    const Interval interval{-1.0, 4.0};
+    Eigen::VectorXd t(m), weights(m);
+    Eigen::MatrixXd z(m, d);
+    for (int i = 0; i < m; ++i) {
+      t[i] = -1.0 + 5.0 * (i + 0.3 * uniform(rng)) / m;
+      weights[i] = uniform(rng);
+      for (int c = 0; c < d; ++c) z(i, c) = std::cos((c + 2) * t[i]) + 0.01 * normal(rng);
+    }
+    for (const Eigen::VectorXd* w : std::vector<const Eigen::VectorXd*>{nullptr, &weights}) {
+      const NormalEquations expected = BuildNormalEquations(t, z, top, interval, w);
+      const NormalMoments moments = BuildNormalMomentsUnchecked(t, z, top, interval, w);
+      ASSERT_EQ(moments.sums.size(), 2 * top + 1);
+      EXPECT_EQ(moments.top_degree(), top);
+      EXPECT_EQ(moments.Gram(), expected.gram) << top;
+      const NormalEquations equations = moments.Equations();
+      EXPECT_EQ(equations.gram, expected.gram) << top;
+      EXPECT_EQ(equations.rhs, expected.rhs) << top;
+      EXPECT_EQ(equations.samples, m);
+      EXPECT_EQ(equations.interval.a, interval.a);
+      EXPECT_EQ(equations.interval.b, interval.b);
+    }
+  }
+}
+
 // The batch Clenshaw runs 32 independent chains at a time; each point's value must be exactly the
 // one-point recurrence (Clenshaw) to rounding, including the partial last block.
 TEST(EvaluateSeries, MatchesPointwiseClenshaw) {

@@ -144,7 +144,7 @@ TEST(GapBridges, HoldTheRateAcrossDropoutsUnderNoise) {
 // spans more gaps than that, stays above the oracle: 3.81 against 1.75 before the longer reaches,
 // 2.57 with them; the bound below holds that gain.
 TEST(GapBridges, TakeOverTheShortSegmentsBetweenManyDropouts) {
-  for (const auto [f_max, bound] : {std::pair{0.2, 1.0}, std::pair{0.1, 1.6}}) {
+  for (const auto& [f_max, bound] : {std::pair{0.2, 1.0}, std::pair{0.1, 1.6}}) {
     double cheval = 0.0, oracle = 0.0;
     int bridges = 0;
     for (uint64_t seed = 1; seed <= 4; ++seed) {

@@ -154,6 +154,44 @@ TEST(SelectNonNegative, FindsWhatNthElementFinds) {
   EXPECT_THROW(internal::SelectNonNegative(&few, 2), std::invalid_argument);
 }
 
+// The noise profile asks how many runs exceed a threshold over stretches from block to block; the
+// counts kept at blocks' starts (and at the end) are those of a count over every run, also across
+// a break, with NaN runs (no usable run) left out and a last block that is not full.
+TEST(DifferenceMagnitudes, CountsPerBlockAreThoseOfEveryRun) {
+  std::mt19937_64 rng(21);
+  std::normal_distribution<double> normal;
+  for (const Eigen::Index m : {Eigen::Index{5}, Eigen::Index{64}, Eigen::Index{1000}, Eigen::Index{1013}}) {
+    Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(m, 0.0, 0.01 * static_cast<double>(m - 1));
+    Eigen::MatrixXd z(m, 2);
+    for (Eigen::Index i = 0; i < m; ++i) z.row(i) << std::sin(t[i]) + 1e-3 * normal(rng), 2e-3 * normal(rng);
+    const internal::DifferenceMagnitudes magnitudes(t, z, {m / 3});
+    const Eigen::Vector2d threshold(1e-3, 2e-3);
+    for (const Eigen::Index stride : {Eigen::Index{1}, Eigen::Index{7}, Eigen::Index{32}}) {
+      const Eigen::MatrixXi counts = magnitudes.CountsAbove(threshold, stride);
+      const Eigen::Index rows = (m + stride - 1) / stride + 1;
+      ASSERT_EQ(counts.rows(), rows);
+      ASSERT_EQ(counts.cols(), 4);
+      for (Eigen::Index row = 0; row < rows; ++row) {
+        const Eigen::Index before = std::min(m, row * stride);  // the runs starting before this sample
+        for (Eigen::Index c = 0; c < 2; ++c) {
+          int usable = 0, above = 0;
+          for (Eigen::Index i = 0; i < before; ++i) {
+            const double v = magnitudes.fourth()(i, c);
+            if (std::isnan(v)) continue;
+            ++usable;
+            if (internal::kMadScale * v > threshold[c]) ++above;
+          }
+          EXPECT_EQ(counts(row, 2 * c), usable) << m << " " << stride << " " << row;
+          EXPECT_EQ(counts(row, 2 * c + 1), above) << m << " " << stride << " " << row;
+        }
+      }
+      if (m < 64) continue;  // 5 samples split at the second have no usable run
+      EXPECT_GT(counts(rows - 1, 1), 0);  // the thresholds are met by some runs and not by others
+      EXPECT_LT(counts(rows - 1, 1), counts(rows - 1, 0));
+    }
+  }
+}
+
 // A recording with two gaps, a glitch, a step of the values and a burst of noise: four segments,
 // jumps found and a raised noise profile, 11,000 samples (the fit, the end caps, the noise
 // estimate and the evaluation of all of them all split their work). Fitted on 1, 2 and 5 threads,
