@@ -992,6 +992,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   if (t[m - 1] == 0.0) throw ComputeError(fmt::format("all {} stamps are equal: there is no time to fit over", m));
 
   std::vector<double> dts;
+  dts.reserve(static_cast<size_t>(m - 1));
   for (Eigen::Index i = 1; i < m; ++i) {
     if (t[i] > t[i - 1]) dts.push_back(t[i] - t[i - 1]);
   }

@@ -199,6 +199,7 @@ struct OrderScale {
 OrderScale ScaleOf(const Eigen::MatrixXd& magnitudes, Eigen::Index begin, Eigen::Index end, Eigen::Index c,
                    bool with_winsorized, std::vector<double>* scratch) {
   scratch->clear();
+  scratch->reserve(static_cast<size_t>(end - begin));
   for (Eigen::Index i = begin; i < end; ++i) {
     if (!std::isnan(magnitudes(i, c))) scratch->push_back(magnitudes(i, c));
   }

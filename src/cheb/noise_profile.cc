@@ -79,6 +79,7 @@ std::optional<SpeedLine> FitSpeedLine(const Eigen::MatrixXd& magnitudes, const E
   std::vector<Bin> bins;
   std::vector<std::pair<double, double>> runs;  // (squared rate, magnitude)
   std::vector<double> scratch;
+  runs.reserve(static_cast<size_t>(m));
   for (Eigen::Index c = 0; c < d; ++c) {
     runs.clear();
     for (Eigen::Index i = 0; i + middle < m; ++i) {
