@@ -99,12 +99,13 @@ constexpr double kMaxMotionDrop = 0.2;
 
 // The magnitudes |Σ w_j z_j| / sqrt(Σ w_j²) of the divided differences of order kRun − 1 of runs
 // of kRun consecutive samples (`cut` marks the boundaries a run may not cross), by the run's first
-// sample and coordinate (m x d): NaN where no usable run starts.
+// sample and coordinate, written into `magnitudes` (m x d, NaN where no usable run starts).
 template <int kRun>
-Eigen::MatrixXd DividedDifferenceMagnitudes(const Eigen::Ref<const Eigen::VectorXd>& t,
-                                            const Eigen::Ref<const Eigen::MatrixXd>& z, const std::vector<char>& cut) {
+void DividedDifferenceMagnitudes(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
+                                 const std::vector<char>& cut, Eigen::MatrixXd* out) {
   const Eigen::Index m = z.rows(), d = z.cols();
-  Eigen::MatrixXd magnitudes = Eigen::MatrixXd::Constant(m, d, std::numeric_limits<double>::quiet_NaN());
+  Eigen::MatrixXd& magnitudes = *out;
+  magnitudes.setConstant(std::numeric_limits<double>::quiet_NaN());
   // Weights in a unit time scale (the run's span): only their ratio to their norm matters. A run
   // placed like the one before (to 1e-9 of its span: even sampling) keeps its weights.
   std::array<double, kRun> u{}, placed{}, w{};
@@ -140,7 +141,6 @@ Eigen::MatrixXd DividedDifferenceMagnitudes(const Eigen::Ref<const Eigen::Vector
       magnitudes(i, c) = std::abs(sum) / norm;
     }
   }
-  return magnitudes;
 }
 
 using internal::kMadScale;
@@ -253,10 +253,16 @@ DifferenceMagnitudes::DifferenceMagnitudes(const Eigen::Ref<const Eigen::VectorX
   for (const Eigen::Index b : breaks) {
     if (b >= 0 && b < m) cut[static_cast<size_t>(b)] = 1;
   }
+  // Allocated here, on the caller's thread, so that what they free serves its later allocations
+  // (glibc keeps another thread's freed memory for that thread), and first written on the threads
+  // (docs/velocity.md, "Speed").
+  eighth_.resize(m, z.cols());
+  sixth_.resize(m, z.cols());
+  fourth_.resize(m, z.cols());
   ParallelFor(3, threads, [&](int order) {
-    if (order == 0) eighth_ = DividedDifferenceMagnitudes<9>(t, z, cut);  // the longest first
-    if (order == 1) sixth_ = DividedDifferenceMagnitudes<7>(t, z, cut);
-    if (order == 2) fourth_ = DividedDifferenceMagnitudes<5>(t, z, cut);
+    if (order == 0) DividedDifferenceMagnitudes<9>(t, z, cut, &eighth_);  // the longest first
+    if (order == 1) DividedDifferenceMagnitudes<7>(t, z, cut, &sixth_);
+    if (order == 2) DividedDifferenceMagnitudes<5>(t, z, cut, &fourth_);
   });
   rates_ = Eigen::MatrixXd::Zero(m, z.cols());
   for (Eigen::Index i = 0; i < m; ++i) {
