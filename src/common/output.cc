@@ -244,15 +244,21 @@ int WriteText(int fd, const OutputFile& file) {
   return 0;
 }
 
-// Finishes a new file: writes the text of `file` unless `error` is set already, flushes it to disk
-// and closes the descriptor in any case (also when `file.write` throws); 0 or the first errno.
-int WriteSyncClose(int fd, const OutputFile& file, int error = 0) {
+// WriteText to a descriptor of its caller's, which is closed before what `file.write` throws is
+// passed on.
+int WriteTextOrClose(int fd, const OutputFile& file) {
   try {
-    if (error == 0) error = WriteText(fd, file);
+    return WriteText(fd, file);
   } catch (...) {
     ::close(fd);
     throw;
   }
+}
+
+// Finishes a new file: writes the text of `file` unless `error` is set already, flushes it to disk
+// and closes the descriptor in any case (also when `file.write` throws); 0 or the first errno.
+int WriteSyncClose(int fd, const OutputFile& file, int error = 0) {
+  if (error == 0) error = WriteTextOrClose(fd, file);
   if (error == 0 && ::fsync(fd) != 0) error = errno;
   if (::close(fd) != 0 && error == 0) error = errno;
   return error;
@@ -327,13 +333,7 @@ int WriteInPlace(const Resolved& target, const OutputFile& file) {
     fd = ::open(target.path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);  // a FIFO blocks until it has a reader
   } while (fd < 0 && errno == EINTR);
   if (fd < 0) return errno;
-  int error = 0;
-  try {
-    error = WriteText(fd, file);
-  } catch (...) {
-    ::close(fd);
-    throw;
-  }
+  int error = WriteTextOrClose(fd, file);
   if (::close(fd) != 0 && error == 0) error = errno;
   return error;
 }

@@ -446,8 +446,6 @@ class Reader {
     return trajectory;
   }
 
-  std::string_view first_comment() const { return scanner_.first_comment(); }
-
  private:
   // Rows in the file, guessed from the first data line's length (only to reserve memory), with a
   // quarter more for lines shorter than the first: a guess 1 % short doubled the poses' memory at
