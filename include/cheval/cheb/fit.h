@@ -56,9 +56,9 @@ NormalEquations BuildNormalEquationsUnchecked(const Eigen::Ref<const Eigen::Vect
                                               const Eigen::Ref<const Eigen::MatrixXd>& z, int top,
                                               const Interval& interval, const Eigen::VectorXd* weights = nullptr);
 
-/// Normal equations kept by the 2·top + 1 sums S_n their matrix is made of, (top + 1)² values
-/// fewer: for systems held many at a time (the folds of a cross-validation at degree 400 took
-/// 1.3 MB each). `Gram()` builds the matrix exactly as BuildNormalEquations does.
+/// Normal equations kept by the 2·top + 1 sums S_n their matrix is made of, in place of its
+/// (top + 1)² entries: for systems held many at a time (the folds of a cross-validation, 1.3 MB
+/// each at degree 400). `Gram()` builds the matrix exactly as BuildNormalEquations does.
 struct NormalMoments {
   Interval interval;
   Eigen::VectorXd sums;  ///< S_0 .. S_{2·top}, S_n = Σ ω_i T_n(x_i)
