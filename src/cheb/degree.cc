@@ -99,7 +99,7 @@ constexpr double kMaxMotionDrop = 0.2;
 
 // The magnitudes |Σ w_j z_j| / sqrt(Σ w_j²) of the divided differences of order kRun − 1 of runs
 // of kRun consecutive samples (`cut` marks the boundaries a run may not cross), by the run's first
-// sample and coordinate, written into `magnitudes` (m x d, NaN where no usable run starts).
+// sample and coordinate, written into `*out` (m x d, already sized; NaN where no usable run starts).
 template <int kRun>
 void DividedDifferenceMagnitudes(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
                                  const std::vector<char>& cut, Eigen::MatrixXd* out) {

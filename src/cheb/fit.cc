@@ -166,8 +166,7 @@ NormalEquations BuildNormalEquations(const Eigen::Ref<const Eigen::VectorXd>& t,
 NormalEquations BuildNormalEquationsUnchecked(const Eigen::Ref<const Eigen::VectorXd>& t,
                                               const Eigen::Ref<const Eigen::MatrixXd>& z, int top,
                                               const Interval& interval, const Eigen::VectorXd* weights) {
-  NormalMoments moments = BuildNormalMomentsUnchecked(t, z, top, interval, weights);
-  return NormalEquations{interval, moments.Gram(), std::move(moments.rhs), moments.samples};
+  return BuildNormalMomentsUnchecked(t, z, top, interval, weights).Equations();
 }
 
 NormalMoments BuildNormalMomentsUnchecked(const Eigen::Ref<const Eigen::VectorXd>& t,

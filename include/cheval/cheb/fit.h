@@ -3,6 +3,7 @@
 /// Weighted least-squares fitting of vector samples by a Chebyshev polynomial, in O(m·N) without
 /// forming the m x (N + 1) design matrix (docs/velocity.md, "Formulas").
 
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -67,7 +68,9 @@ struct NormalMoments {
   int top_degree() const { return static_cast<int>(rhs.rows()) - 1; }
   /// G_ij = (S_{i+j} + S_{|i-j|}) / 2, (top + 1) x (top + 1).
   Eigen::MatrixXd Gram() const;
-  NormalEquations Equations() const { return NormalEquations{interval, Gram(), rhs, samples}; }
+  NormalEquations Equations() const& { return NormalEquations{interval, Gram(), rhs, samples}; }
+  /// As above, taking `rhs` instead of copying it.
+  NormalEquations Equations() && { return NormalEquations{interval, Gram(), std::move(rhs), samples}; }
 };
 
 /// BuildNormalEquationsUnchecked's system by its sums.
