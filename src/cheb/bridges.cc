@@ -21,7 +21,7 @@ namespace {
 // The samples within this many gap lengths on either side of a gap are fitted across it: of the
 // reaches whose fits pass the residual test and agree (kAgreement), the one whose rates beside the
 // gap have the least variance (the longest the motion allows, for it is smooth enough there).
-constexpr std::array<double, 4> kReaches{2.0, 4.0, 8.0, 16.0};
+constexpr std::array<double, 5> kReaches{2.0, 4.0, 8.0, 16.0, 32.0};
 // The reaches' rates beside a gap agree while their intervals of this many standard deviations
 // share a point, on both sides and in every coordinate: the intersection of confidence intervals
 // (Goldenshluger & Nemirovski 1997). A longer reach buys its smaller variance with a bias that its
