@@ -33,6 +33,10 @@ constexpr Eigen::Index kMinSide = 4;
 // The slope of a fit's residuals where it takes over may reach this many of its standard deviations
 // (as the residual test's limit, kLackOfFitLimit).
 constexpr double kTrendLimit = 3.0;
+// NestedResidualFloor: the floor lies this far below the top degree's residual sum of squares, and
+// only where the evaluation's rounding is at most kRoundingShare of that margin.
+constexpr double kNestedMargin = 1e-4;
+constexpr double kRoundingShare = 0.01;
 // N²/m of a fit across a gap at most, as the windows' (CurveOptions::max_conditioning's default).
 constexpr double kMaxConditioning = 8.0;
 
@@ -89,11 +93,19 @@ Bridge FitBridge(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Inde
   Bridge bridge{std::vector<int>(static_cast<size_t>(d), 1), Eigen::VectorXd(d), Eigen::VectorXd(d)};
   Eigen::VectorXd best = Eigen::VectorXd::Constant(d, std::numeric_limits<double>::infinity());
   Eigen::VectorXd rss = Eigen::VectorXd::Zero(d);
+  // Residuals on the samples themselves: the sums of the normal equations lose nearly exact data's.
+  // That costs m·n a degree, so the top degree's are taken first: no degree leaves less, and a
+  // degree whose score could not beat any coordinate's best even at that floor is not evaluated. The
+  // choice is the one every degree's evaluation gives.
+  auto residual_squares = [&](int n) -> Eigen::VectorXd {
+    return (zw - EvaluateSeries(cholesky.Solve(n, normal.rhs), x)).colwise().squaredNorm().transpose();
+  };
+  const Eigen::VectorXd floor = NestedResidualFloor(zw, residual_squares(top), top);
   for (int n = 1; n <= top; ++n) {
-    // Residuals on the samples themselves: the sums of the normal equations lose nearly exact data's.
-    const Eigen::VectorXd squares =
-        (zw - EvaluateSeries(cholesky.Solve(n, normal.rhs), x)).colwise().squaredNorm().transpose();
     const double free = static_cast<double>(count - n - 1);
+    const Eigen::ArrayXd least = static_cast<double>(count) * floor.array() / (free * free);
+    if ((least >= best.array()).all()) continue;
+    const Eigen::VectorXd squares = residual_squares(n);
     for (Eigen::Index c = 0; c < d; ++c) {
       const double score = static_cast<double>(count) * squares[c] / (free * free);
       if (score < best[c]) best[c] = score, bridge.degrees[static_cast<size_t>(c)] = n, rss[c] = squares[c];
@@ -315,6 +327,22 @@ void Insert(CurveWindow bridge, double boundary, bool back, CurveSegment* segmen
 }
 
 }  // namespace
+
+Eigen::VectorXd NestedResidualFloor(const Eigen::Ref<const Eigen::MatrixXd>& z, const Eigen::VectorXd& top_squares,
+                                    int top) {
+  const double m = static_cast<double>(z.rows());
+  // A residual evaluated by Clenshaw's recurrence is off by up to ~ε·(N + 1)² times the values'
+  // size; relative to the residual sum of squares that is 2·that·sqrt(m / RSS).
+  const double rounding = std::numeric_limits<double>::epsilon() * (top + 1.0) * (top + 1.0);
+  Eigen::VectorXd floor = Eigen::VectorXd::Zero(z.cols());
+  for (Eigen::Index c = 0; c < z.cols(); ++c) {
+    const double relative = 2.0 * rounding * z.col(c).cwiseAbs().maxCoeff() * std::sqrt(m / top_squares[c]);
+    if (std::isfinite(relative) && relative <= kRoundingShare * kNestedMargin) {
+      floor[c] = (1.0 - kNestedMargin) * top_squares[c];
+    }
+  }
+  return floor;
+}
 
 void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<Eigen::Index>& starts,
                 const NoiseProfile& noise, const Eigen::VectorXd& rounding, std::vector<CurveSegment>* segments,

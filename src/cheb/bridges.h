@@ -16,7 +16,7 @@ namespace cheval::cheb::internal {
 /// A gap splits the data into segments fitted apart, and the samples next to it are a segment's
 /// end, whose rate a one-sided fit gives with a variance growing like N⁴/m: under noise, a
 /// recording with many dropouts is mostly such ends. Across a gap of length g the samples within
-/// 2g, 4g or 8g on either side (at least 4 on each; across further gaps, not across a jump) are
+/// 2g, 4g, 8g, 16g or 32g on either side (at least 4 on each; across further gaps, not across a jump) are
 /// fitted by one polynomial of degree at most (π/2)·span/h, h the longest hole inside (what it
 /// allows: WindowFitter::TopDegree), N²/m ≤ 8 and m/2 − 1, chosen per coordinate by generalised
 /// cross-validation; its residual must pass the residual test, and of the reaches that pass, the
@@ -28,8 +28,8 @@ namespace cheval::cheb::internal {
 ///      slope is the noise's; on nearly noise-free data it is the bias of a fit held to a hole's
 ///      low degree, where the segment's own end is exact.
 /// A segment that the fits of its gaps cover whole (a short one between dropouts) is replaced by
-/// those that help over all of it (with the smaller variance at both its ends), two meeting
-/// half-way in time. Otherwise a side becomes the segment's last (or first) window, re-expanded
+/// one that helps over all of it (with the smaller variance at both its ends); where both do, by
+/// the one whose rate has the smaller variance at the segment's two ends. Otherwise a side becomes the segment's last (or first) window, re-expanded
 /// exactly on the segment's samples it covers, as an end cap does: alone over the z/2 samples
 /// next to the gap and blended into the segment's windows up to 1.5z, z a third of its samples
 /// within reach (and of the segment's). Its verdict is WindowVerdict::kBridge.
@@ -41,5 +41,14 @@ namespace cheval::cheb::internal {
 void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<Eigen::Index>& starts,
                 const NoiseProfile& noise, const Eigen::VectorXd& rounding, std::vector<CurveSegment>* segments,
                 int threads = 1);
+
+/// A floor under the residual sums of squares of every least-squares fit of `z` (m x d) of degree
+/// at most `top` on the same samples, per coordinate, from the top degree's `top_squares`: the fits
+/// are nested, so none leaves less. It lies 1e-4 of it below, for the rounding of residuals
+/// evaluated on the samples; 0 where that rounding could reach 1 % of that margin (nearly exact
+/// data, or values large against their residual). Generalised cross-validation across a gap skips
+/// the degrees whose score could not beat the best at that floor.
+Eigen::VectorXd NestedResidualFloor(const Eigen::Ref<const Eigen::MatrixXd>& z, const Eigen::VectorXd& top_squares,
+                                    int top);
 
 }  // namespace cheval::cheb::internal

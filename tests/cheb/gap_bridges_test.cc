@@ -14,7 +14,9 @@
 #include <Eigen/QR>
 #include <gtest/gtest.h>
 
+#include "bridges.h"
 #include "cheval/cheb/curve.h"
+#include "cheval/cheb/fit.h"
 #include "synthetic_motion.h"
 
 namespace cheval::cheb {
@@ -222,6 +224,52 @@ TEST(GapBridges, AreExactOnNoiseFreeData) {
     EXPECT_LT(worst, 1e-5) << "seed " << seed;
   }
   EXPECT_GT(bridges, 0);  // some were taken: the bound says something
+}
+
+// Generalised cross-validation across a gap evaluates a degree's residuals on the samples only where
+// its score could beat the best at NestedResidualFloor; so the floor must lie under every degree's
+// evaluated residual sum of squares, or a degree could be skipped that would have been chosen. Over
+// noisy samples beside a hole it does, and is taken (else nothing is skipped). Where the residual
+// is near the evaluation's rounding, from nearly exact data or from values far from the origin
+// (coordinates in a UTM zone), there is none.
+TEST(GapBridges, NestedResidualFloorLiesUnderEveryDegreesResidual) {
+  std::mt19937_64 rng(3);
+  const std::vector<Tone> tones = SweepTones(0.5, &rng);
+  std::normal_distribution<double> gauss;
+  for (const double noise : {0.0, 1e-6, 5e-4}) {
+    for (const double offset : {0.0, 5e5}) {
+      std::vector<double> times;
+      for (int i = 0; i < 1200; ++i) {
+        if (i < 500 || i >= 560) times.push_back(0.01 * i);  // a hole of 0.6 s
+      }
+      const auto m = static_cast<Eigen::Index>(times.size());
+      Eigen::VectorXd t(m);
+      Eigen::MatrixXd z(m, 3);
+      for (Eigen::Index i = 0; i < m; ++i) {
+        t[i] = times[static_cast<size_t>(i)];
+        Eigen::Vector3d p, v;
+        EvaluateTones(tones, t[i], &p, &v);
+        for (int c = 0; c < 3; ++c) z(i, c) = p[c] + offset + noise * gauss(rng);
+      }
+      const int top = 60;
+      const Interval interval{t[0], t[m - 1]};
+      const NormalEquations normal = BuildNormalEquations(t, z, top, interval);
+      const NestedCholesky cholesky(normal, top);
+      Eigen::VectorXd x(m);
+      for (Eigen::Index i = 0; i < m; ++i) x[i] = interval.ToUnit(t[i]);
+      auto squares = [&](int n) -> Eigen::VectorXd {
+        return (z - EvaluateSeries(cholesky.Solve(n, normal.rhs), x)).colwise().squaredNorm().transpose();
+      };
+      const Eigen::VectorXd floor = internal::NestedResidualFloor(z, squares(top), top);
+      SCOPED_TRACE(testing::Message() << "noise " << noise << ", offset " << offset << ", floor " << floor.transpose());
+      for (int n = 1; n <= top; ++n) EXPECT_TRUE((squares(n).array() >= floor.array()).all()) << "degree " << n;
+      if (noise == 5e-4 && offset == 0.0) {
+        EXPECT_TRUE((floor.array() > 0.0).all());
+      } else if (noise == 0.0) {
+        EXPECT_TRUE((floor.array() == 0.0).all());
+      }
+    }
+  }
 }
 
 }  // namespace
