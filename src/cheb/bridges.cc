@@ -100,12 +100,13 @@ Bridge FitBridge(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Inde
   auto residual_squares = [&](int n) -> Eigen::VectorXd {
     return (zw - EvaluateSeries(cholesky.Solve(n, normal.rhs), x)).colwise().squaredNorm().transpose();
   };
-  const Eigen::VectorXd floor = NestedResidualFloor(zw, residual_squares(top), top);
+  const Eigen::VectorXd top_squares = residual_squares(top);
+  const Eigen::VectorXd floor = NestedResidualFloor(zw, top_squares, top);
   for (int n = 1; n <= top; ++n) {
     const double free = static_cast<double>(count - n - 1);
     const Eigen::ArrayXd least = static_cast<double>(count) * floor.array() / (free * free);
     if ((least >= best.array()).all()) continue;
-    const Eigen::VectorXd squares = residual_squares(n);
+    const Eigen::VectorXd squares = n == top ? top_squares : residual_squares(n);
     for (Eigen::Index c = 0; c < d; ++c) {
       const double score = static_cast<double>(count) * squares[c] / (free * free);
       if (score < best[c]) best[c] = score, bridge.degrees[static_cast<size_t>(c)] = n, rss[c] = squares[c];
