@@ -155,10 +155,12 @@ class VelocityTest(unittest.TestCase):
         rounded = {"stamps": stamps, "positions": np.round(positions, 3)}
         out = cheval.velocity(rounded)
         np.testing.assert_allclose(out["curve"].resolution, [1e-3] * 3, rtol=1e-9)
+        self.assertEqual(out["curve"].staircase, [True] * 3)  # moving less than a step a sample
         central = cheval.velocity(rounded, method="central")
         self.assertLess(rmse(out["velocities"], truth), 0.1 * rmse(central["velocities"], truth))
-        np.testing.assert_array_equal(cheval.velocity({"stamps": stamps, "positions": positions})["curve"].resolution,
-                                      [0.0] * 3)
+        plain = cheval.velocity({"stamps": stamps, "positions": positions})["curve"]
+        np.testing.assert_array_equal(plain.resolution, [0.0] * 3)
+        self.assertEqual(plain.staircase, [False] * 3)
 
 
 class FitTest(unittest.TestCase):

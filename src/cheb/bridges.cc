@@ -188,7 +188,7 @@ class RateAgreement {
 // too (between dropouts the segments are short) but inside [before, after) (not across a jump).
 std::optional<GapFit> FitGap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index before, Eigen::Index gap,
                              Eigen::Index after, double reach, const NoiseProfile& noise,
-                             const Eigen::VectorXd& rounding) {
+                             const Eigen::VectorXd& sigma_floor) {
   const double* data = t.data();
   GapFit fit;
   fit.gap = gap;
@@ -206,8 +206,8 @@ std::optional<GapFit> FitGap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z,
                                                      std::floor(std::sqrt(kMaxConditioning * static_cast<double>(fit.count))),
                                                      static_cast<double>(fit.count / 2 - 1)}));
   if (top < 1) return std::nullopt;
-  // As a window's (WindowSigma), and at least the values' rounding level.
-  fit.sigma = WindowSigma(noise.Over(fit.first, fit.count), z.middleRows(fit.first, fit.count)).cwiseMax(rounding);
+  // As a window's (WindowSigma), and at least the floor (the values' rounding level).
+  fit.sigma = WindowSigma(noise.Over(fit.first, fit.count), z.middleRows(fit.first, fit.count)).cwiseMax(sigma_floor);
   try {
     fit.bridge = FitBridge(t, z, fit.first, fit.count, interval, top, fit.sigma);
     if (!fit.bridge.passes) return std::nullopt;
@@ -346,7 +346,7 @@ Eigen::VectorXd NestedResidualFloor(const Eigen::Ref<const Eigen::MatrixXd>& z, 
 }
 
 void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<Eigen::Index>& starts,
-                const NoiseProfile& noise, const Eigen::VectorXd& rounding, std::vector<CurveSegment>* segments,
+                const NoiseProfile& noise, const Eigen::VectorXd& sigma_floor, std::vector<CurveSegment>* segments,
                 int threads) {
   const size_t count = segments->size();
   // The first (and one past the last) segment of the run of segments joined by gaps, not jumps,
@@ -364,7 +364,7 @@ void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
     RateAgreement agreement(z.cols());
     for (const double reach : kReaches) {
       std::optional<GapFit> fit = FitGap(t, z, starts[run_begin[k]], gap, starts[run_end[k + 1]],
-                                         reach * (t[gap] - t[gap - 1]), noise, rounding);
+                                         reach * (t[gap] - t[gap - 1]), noise, sigma_floor);
       if (!fit) continue;
       if (!agreement.Admit(t, *fit)) break;  // a longer reach would not agree either
       const Eigen::VectorXd variance = fit->sigma.cwiseAbs2();

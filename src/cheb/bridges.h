@@ -37,10 +37,10 @@ namespace cheval::cheb::internal {
 ///
 /// `t` (sorted, s) and `z` are the curve's samples, `starts` the segments' first samples followed
 /// by the sample count, `segments` their fits (ends capped; a segment that `continues` ends at a
-/// jump, not a gap), `noise` the samples' noise profile and `rounding` the values' rounding level
-/// per coordinate. The gaps are fitted on up to `threads` threads.
+/// jump, not a gap), `noise` the samples' noise profile and `sigma_floor` the floor of their noise σ
+/// per coordinate (the values' rounding level). The gaps are fitted on up to `threads` threads.
 void BridgeGaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<Eigen::Index>& starts,
-                const NoiseProfile& noise, const Eigen::VectorXd& rounding, std::vector<CurveSegment>* segments,
+                const NoiseProfile& noise, const Eigen::VectorXd& sigma_floor, std::vector<CurveSegment>* segments,
                 int threads = 1);
 
 /// A floor under the residual sums of squares of every least-squares fit of `z` (m x d) of degree

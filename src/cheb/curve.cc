@@ -8,6 +8,7 @@
 #include "local_regression.h"
 #include "noise_profile.h"
 #include "residual_test.h"
+#include "staircase.h"
 #include "work_queue.h"
 
 #include <algorithm>
@@ -1006,14 +1007,28 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   // Values rounded to a lattice carry its noise, q/sqrt(12), also where the differences see less
   // (a staircase: motion slower than a step a sample); an estimate is floored where they were
   // rounded, not where exact motion lies on a lattice by itself (IsRounded).
+  // A staircase of rounded values (slow motion, a coarse step) is placed between its steps
+  // (PlaceBetweenSteps), and its floor is the error of the instants it crosses them at. That error
+  // is white from crossing to crossing, so the two-sided tests of a rounding floor (whose errors
+  // are correlated over a step) are not made there: curve.rounding_ is 0 for it. A step given by
+  // the caller is not one the values need lie on, and they are left as they are.
   curve.resolution_ = Eigen::VectorXd::Zero(z.cols());
   curve.rounding_ = Eigen::VectorXd::Zero(z.cols());
+  curve.staircase_.assign(static_cast<size_t>(z.cols()), false);
+  Eigen::VectorXd sigma_floor = Eigen::VectorXd::Zero(z.cols());
   for (Eigen::Index c = 0; c < z.cols(); ++c) {
     const double q = options.resolution > 0.0 ? options.resolution : FindResolution(z.col(c));
     curve.resolution_[c] = q;
     if (q > 0.0 && (options.resolution > 0.0 || IsRounded(z.col(c), q))) curve.rounding_[c] = q / std::sqrt(12.0);
+    sigma_floor[c] = curve.rounding_[c];
+    if (options.resolution > 0.0 || curve.rounding_[c] == 0.0) continue;
+    if (const std::optional<double> placed = internal::PlaceBetweenSteps(t, z.col(c), q, gaps)) {
+      sigma_floor[c] = *placed;
+      curve.rounding_[c] = 0.0;
+      curve.staircase_[static_cast<size_t>(c)] = true;
+    }
   }
-  auto floored = [&](Eigen::VectorXd sigma) { return sigma.cwiseMax(curve.rounding_).eval(); };
+  auto floored = [&](Eigen::VectorXd sigma) { return sigma.cwiseMax(sigma_floor).eval(); };
 
   // Jumps and glitches (CurveOptions::robust): outliers leave the fit, jumps split it.
   internal::Jumps jumps;
@@ -1221,7 +1236,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
                            &curve.segments_[k], threads);
     }
     // Then fits across the gaps take over the segments' ends where they are the better estimate.
-    internal::BridgeGaps(t, z, starts, profile, curve.rounding_, &curve.segments_, threads);
+    internal::BridgeGaps(t, z, starts, profile, sigma_floor, &curve.segments_, threads);
   }
 
   // Where windows clearly missed motion, the samples' own local interpolant (docs/velocity.md).
@@ -1267,7 +1282,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
       segment_runs[static_cast<size_t>(k)] = internal::LocalRegressionRuns(
           t, z, starts[k], starts[k + 1], curve.segments_[k], local ? window_values : fit_values,
           local ? window_rates : fit_rates, fit_values, fit_rates, local ? &local_samples[k] : nullptr, profile,
-          curve.rounding_);
+          curve.rounding_, curve.staircase_);
     });
     std::vector<LocalRun> regression;
     for (size_t k = 0; k + 1 < starts.size(); ++k) {
@@ -1559,6 +1574,10 @@ void Curve::EvaluateMany(std::span<const int64_t> stamps_ns, int order, Eigen::M
 
 bool Curve::AtRounding(Eigen::Index c) const {
   return c >= 0 && c < rounding_.size() && internal::AtRoundingLevel(noise_sigma_[c], rounding_[c]);
+}
+
+bool Curve::Staircase(Eigen::Index c) const {
+  return c >= 0 && static_cast<size_t>(c) < staircase_.size() && staircase_[static_cast<size_t>(c)];
 }
 
 Curve Curve::FromParts(int64_t origin_ns, std::vector<CurveSegment> segments, Eigen::VectorXd noise_sigma,

@@ -340,7 +340,7 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
                                           const Eigen::MatrixXd& window_values, const Eigen::MatrixXd& window_rates,
                                           const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
                                           const LocalSamples* local, const NoiseProfile& noise,
-                                          const Eigen::VectorXd& rounding) {
+                                          const Eigen::VectorXd& rounding, const std::vector<bool>& staircase) {
   std::vector<LocalRun> runs;
   const std::vector<CurveWindow>& windows = segment.windows;
   const Eigen::Index n = last - first, d = z.cols();
@@ -463,7 +463,8 @@ std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen:
       if (!scores) break;
       for (Eigen::Index c = 0; c < d; ++c) {
         if (rung > 0 && !biased[static_cast<size_t>(c)]) continue;
-        if (AtRoundingLevel(sigma[c], rounding[c])) continue;  // a staircase's errors are not white
+        // A staircase's errors are not white, as read or placed.
+        if (staircase[static_cast<size_t>(c)] || AtRoundingLevel(sigma[c], rounding[c])) continue;
         const StretchScores::Choice choice = scores->Choose(c, sigma[c]);
         chosen[static_cast<size_t>(c)] = choice.candidate;
         biased[static_cast<size_t>(c)] = choice.biased_pilot;

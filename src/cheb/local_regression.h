@@ -48,13 +48,16 @@ bool RegressionMayGain(const CurveWindow& window);
 /// `fit_values` and `fit_rates` the present curve's (the local interpolant's where it took over),
 /// `local` the segment's local samples (none: the windows' fit throughout), `noise` the curve's
 /// noise profile (σ per stretch: its RMS over the stretch), `rounding` per coordinate q/sqrt(12) of
-/// rounded values (0: not rounded). A coordinate whose σ over a stretch is the rounding's keeps its
-/// rate there: its errors form a staircase, which the scores, made for white noise, would follow.
+/// rounded values (0: not rounded), `staircase` whether a coordinate was placed between its steps
+/// (Curve::Staircase). A coordinate whose σ over a stretch is the rounding's keeps its rate there:
+/// its errors form a staircase, which the scores, made for white noise, would follow; so does a
+/// staircase placed between its steps everywhere, whose errors run smoothly from crossing to
+/// crossing (tones rounded to 1 mm at 1000 Hz: 3.3 → 15.3 mm/s on one axis).
 std::vector<LocalRun> LocalRegressionRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Eigen::Index first,
                                           Eigen::Index last, const CurveSegment& segment,
                                           const Eigen::MatrixXd& window_values, const Eigen::MatrixXd& window_rates,
                                           const Eigen::MatrixXd& fit_values, const Eigen::MatrixXd& fit_rates,
                                           const LocalSamples* local, const NoiseProfile& noise,
-                                          const Eigen::VectorXd& rounding);
+                                          const Eigen::VectorXd& rounding, const std::vector<bool>& staircase);
 
 }  // namespace cheval::cheb::internal

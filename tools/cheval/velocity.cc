@@ -116,15 +116,22 @@ void Run(const VelocityFlags& flags) {
                "(RMS) make them; the fit takes that noise into account (docs/velocity.md, \"Stamp noise\")\n",
                flags.input, 1e3 * curve.stamp_noise_s());
   }
-  std::string staircase;
+  std::string at_rounding, staircase;
   for (Eigen::Index c = 0; c < 3; ++c) {
-    if (!curve.AtRounding(c)) continue;
-    staircase += fmt::format("{}{} to {:.3g} mm", staircase.empty() ? "" : ", ", "xyz"[c], 1e3 * curve.resolution()[c]);
+    std::string* list = curve.Staircase(c) ? &staircase : curve.AtRounding(c) ? &at_rounding : nullptr;
+    if (list == nullptr) continue;
+    *list += fmt::format("{}{} to {:.3g} mm", list->empty() ? "" : ", ", "xyz"[c], 1e3 * curve.resolution()[c]);
   }
-  if (!staircase.empty()) {
+  if (!at_rounding.empty()) {
     fmt::print(stderr, "cheval: note: {}: the positions are rounded ({}) and their differences read no more noise than "
                "that rounding's, step/sqrt(12): the fit takes it as their noise, and a staircase of them is not taken "
                "for motion (docs/velocity.md, \"Rounded positions\")\n",
+               flags.input, at_rounding);
+  }
+  if (!staircase.empty()) {
+    fmt::print(stderr, "cheval: note: {}: the positions are rounded ({}) and move less than a step a sample: they were "
+               "placed between their steps, on a curve through the instants they pass from one step to the next "
+               "(docs/velocity.md, \"Rounded positions\")\n",
                flags.input, staircase);
   }
   size_t windows = 0;

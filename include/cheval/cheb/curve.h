@@ -252,6 +252,11 @@ class Curve {
   /// differences read less noise than the rounding (a staircase, or a median of 4th differences
   /// that is itself a whole number of steps).
   bool AtRounding(Eigen::Index c) const;
+  /// Whether coordinate c's values were rounded to a step they moved less than a sample at a time
+  /// (a staircase), and were fitted placed between their steps: on a curve through the instants
+  /// they pass from one step to the next, each within its own step (docs/velocity.md, "Rounded
+  /// positions"). Its noise σ is then at least those instants' error, not the step's.
+  bool Staircase(Eigen::Index c) const;
   /// Root mean square of the fit residuals over the samples fitted (outliers left out), per coordinate.
   const Eigen::VectorXd& residual_rms() const { return residual_rms_; }
   /// Total number of stored values (Σ over windows of (degree + 1) per coordinate).
@@ -298,7 +303,8 @@ class Curve {
   Eigen::VectorXd noise_sigma_max_;  // empty: noise_sigma_
   double stamp_noise_s_ = 0.0;
   Eigen::VectorXd resolution_;  // per coordinate, 0: not rounded
-  Eigen::VectorXd rounding_;    // per coordinate, the floor q/sqrt(12) of σ, 0: none
+  Eigen::VectorXd rounding_;    // per coordinate, the floor of σ (q/sqrt(12), or a staircase's), 0: none
+  std::vector<bool> staircase_;  // per coordinate, placed between its steps
   Eigen::VectorXd residual_rms_;
   std::vector<double> outlier_times_, jump_times_, step_times_;
   // Row k: the sum of the first k + 1 steps, added to values after step_times_[k].
