@@ -113,15 +113,10 @@ Raises ComputeError for a stamp outside the data by more than `tolerance` second
                              "Per coordinate, the step the values were rounded to (0 where they were not); an "
                              "estimated noise sigma is at least step/sqrt(12), except on a staircase (docs/velocity.md, "
                              "\"Rounded positions\").")
-      .def_property_readonly(
-          "staircase",
-          [](const cheb::Curve& c) {
-            std::vector<bool> placed(static_cast<size_t>(c.dimension()));
-            for (int k = 0; k < c.dimension(); ++k) placed[static_cast<size_t>(k)] = c.Staircase(k);
-            return placed;
-          },
-          "Per coordinate, whether the values were rounded to a step they moved less than a sample at a time, and "
-          "were fitted placed between their steps (docs/velocity.md, \"Rounded positions\").")
+      .def_property_readonly("staircase", &cheb::Curve::staircase,
+                             "Per coordinate, whether the values were rounded to a step they moved less than a "
+                             "sample at a time, and were fitted placed between their steps (docs/velocity.md, "
+                             "\"Rounded positions\").")
       .def_property_readonly("residual_rms", &cheb::Curve::residual_rms, "RMS of the fit residuals per coordinate.")
       .def_property_readonly("stored_values", &cheb::Curve::stored_values,
                              "Sum over windows of (degree + 1) per coordinate.")

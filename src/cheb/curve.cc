@@ -1006,12 +1006,12 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
 
   // Values rounded to a lattice carry its noise, q/sqrt(12), also where the differences see less
   // (a staircase: motion slower than a step a sample); an estimate is floored where they were
-  // rounded, not where exact motion lies on a lattice by itself (IsRounded).
-  // A staircase of rounded values (slow motion, a coarse step) is placed between its steps
-  // (PlaceBetweenSteps), and its floor is the error of the instants it crosses them at. That error
-  // is white from crossing to crossing, so the two-sided tests of a rounding floor (whose errors
-  // are correlated over a step) are not made there: curve.rounding_ is 0 for it. A step given by
-  // the caller is not one the values need lie on, and they are left as they are.
+  // rounded, not where exact motion lies on a lattice by itself (IsRounded). A clean staircase is
+  // placed between its steps instead (PlaceBetweenSteps), and its floor is how well its crossings
+  // predict each other. Its errors are no longer the rounding's, so the rounding's two-sided
+  // degree test is not made on it (curve.rounding_ is 0 there); the local regression leaves it
+  // alone all the same (curve.staircase_). A step given by the caller is not one the values need
+  // lie on, and they are left as they are.
   curve.resolution_ = Eigen::VectorXd::Zero(z.cols());
   curve.rounding_ = Eigen::VectorXd::Zero(z.cols());
   curve.staircase_.assign(static_cast<size_t>(z.cols()), false);
@@ -1576,10 +1576,6 @@ bool Curve::AtRounding(Eigen::Index c) const {
   return c >= 0 && c < rounding_.size() && internal::AtRoundingLevel(noise_sigma_[c], rounding_[c]);
 }
 
-bool Curve::Staircase(Eigen::Index c) const {
-  return c >= 0 && static_cast<size_t>(c) < staircase_.size() && staircase_[static_cast<size_t>(c)];
-}
-
 Curve Curve::FromParts(int64_t origin_ns, std::vector<CurveSegment> segments, Eigen::VectorXd noise_sigma,
                        Eigen::VectorXd residual_rms) {
   if (segments.empty()) throw std::invalid_argument("Curve::FromParts: no segments");
@@ -1610,6 +1606,7 @@ Curve Curve::FromParts(int64_t origin_ns, std::vector<CurveSegment> segments, Ei
   curve.residual_rms_ = std::move(residual_rms);
   curve.resolution_ = Eigen::VectorXd::Zero(d);
   curve.rounding_ = Eigen::VectorXd::Zero(d);
+  curve.staircase_.assign(static_cast<size_t>(d), false);
   return curve;
 }
 

@@ -415,7 +415,7 @@ std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimat
     j["stamp_noise_s"] = curve.stamp_noise_s();
     j["skipped_at"] = estimate.skipped.size();
     j["position_resolution_m"] = std::vector<double>(curve.resolution().data(), curve.resolution().data() + 3);
-    j["position_staircase"] = {curve.Staircase(0), curve.Staircase(1), curve.Staircase(2)};
+    j["position_staircase"] = curve.staircase();
     if (estimate.rounded_stamps) {
       j["rounded_stamps"] = {{"resolution_s", estimate.rounded_stamps->resolution_s()},
                              {"rate_hz", estimate.rounded_stamps->rate_hz()}};

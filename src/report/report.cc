@@ -146,11 +146,7 @@ Json FitDiagnostics(const cheb::Curve& curve, const Clock& clock, std::size_t ma
                  for (int c = 0; c < curve.dimension(); ++c) at[static_cast<size_t>(c)] = curve.AtRounding(c);
                  return at;
                }()},
-              {"staircase", [&curve] {
-                 std::vector<bool> placed(static_cast<size_t>(curve.dimension()));
-                 for (int c = 0; c < curve.dimension(); ++c) placed[static_cast<size_t>(c)] = curve.Staircase(c);
-                 return placed;
-               }()},
+              {"staircase", curve.staircase()},
               {"residual_rms", std::vector<double>(residual.data(), residual.data() + residual.size())},
               {"unresolved_windows", curve.unresolved_windows()},
               {"local_samples", curve.local_samples()}};

@@ -574,7 +574,7 @@ TEST(RoundedPositions, ASlowStaircaseIsMotionNotJumps) {
     const Curve curve = FitCurve(s.stamps, s.positions);
     for (Eigen::Index c = 0; c < 3; ++c) {
       EXPECT_NEAR(curve.resolution()[c], 1e-3, 1e-12) << rate << " Hz";
-      EXPECT_TRUE(curve.Staircase(c)) << rate << " Hz, coordinate " << c;
+      EXPECT_TRUE(curve.staircase()[static_cast<size_t>(c)]) << rate << " Hz, coordinate " << c;
       EXPECT_FALSE(curve.AtRounding(c)) << rate << " Hz, coordinate " << c;
       EXPECT_LT(curve.noise_sigma()[c], 0.2 * 1e-3 / std::sqrt(12.0)) << rate << " Hz, coordinate " << c;
     }
@@ -649,7 +649,7 @@ TEST(RoundedPositions, OnlyACleanStaircaseIsPlaced) {
       EXPECT_EQ(values, rounded.col(c)) << c;
     }
     const Curve curve = FitCurve(s->stamps, rounded);
-    for (Eigen::Index c = 0; c < 3; ++c) EXPECT_FALSE(curve.Staircase(c)) << c;
+    for (Eigen::Index c = 0; c < 3; ++c) EXPECT_FALSE(curve.staircase()[static_cast<size_t>(c)]) << c;
   }
 }
 

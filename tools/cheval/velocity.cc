@@ -118,7 +118,7 @@ void Run(const VelocityFlags& flags) {
   }
   std::string at_rounding, staircase;
   for (Eigen::Index c = 0; c < 3; ++c) {
-    std::string* list = curve.Staircase(c) ? &staircase : curve.AtRounding(c) ? &at_rounding : nullptr;
+    std::string* list = curve.staircase()[static_cast<size_t>(c)] ? &staircase : curve.AtRounding(c) ? &at_rounding : nullptr;
     if (list == nullptr) continue;
     *list += fmt::format("{}{} to {:.3g} mm", list->empty() ? "" : ", ", "xyz"[c], 1e3 * curve.resolution()[c]);
   }

@@ -252,11 +252,12 @@ class Curve {
   /// differences read less noise than the rounding (a staircase, or a median of 4th differences
   /// that is itself a whole number of steps).
   bool AtRounding(Eigen::Index c) const;
-  /// Whether coordinate c's values were rounded to a step they moved less than a sample at a time
-  /// (a staircase), and were fitted placed between their steps: on a curve through the instants
-  /// they pass from one step to the next, each within its own step (docs/velocity.md, "Rounded
-  /// positions"). Its noise σ is then at least those instants' error, not the step's.
-  bool Staircase(Eigen::Index c) const;
+  /// Per coordinate, whether its values were rounded to a step they moved less than a sample at a
+  /// time (a staircase), and were fitted placed between their steps: on a curve through the
+  /// instants they pass from one step to the next, each within its own step (docs/velocity.md,
+  /// "Rounded positions"). Its noise σ is then at least how well those crossings predict each
+  /// other, not the step's q/sqrt(12).
+  const std::vector<bool>& staircase() const { return staircase_; }
   /// Root mean square of the fit residuals over the samples fitted (outliers left out), per coordinate.
   const Eigen::VectorXd& residual_rms() const { return residual_rms_; }
   /// Total number of stored values (Σ over windows of (degree + 1) per coordinate).
