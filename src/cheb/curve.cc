@@ -1005,8 +1005,10 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   }
 
   // Values rounded to a lattice carry its noise, q/sqrt(12), also where the differences see less
-  // (a staircase: motion slower than a step a sample); an estimate is floored where they were
-  // rounded, not where exact motion lies on a lattice by itself (IsRounded). A clean staircase is
+  // (a staircase: motion slower than a step a sample), and more with noise added before the
+  // rounding, which the median of whole-step differences reads coarsely (RoundingLevel); an
+  // estimate is floored where they were rounded, not where exact motion lies on a lattice by
+  // itself (IsRounded). A clean staircase is
   // placed between its steps instead (PlaceBetweenSteps), and its floor is how well its crossings
   // predict each other. Its errors are no longer the rounding's, so the rounding's two-sided
   // degree test is not made on it (curve.rounding_ is 0 there); the local regression leaves it
@@ -1019,7 +1021,11 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   for (Eigen::Index c = 0; c < z.cols(); ++c) {
     const double q = options.resolution > 0.0 ? options.resolution : FindResolution(z.col(c));
     curve.resolution_[c] = q;
-    if (q > 0.0 && (options.resolution > 0.0 || IsRounded(z.col(c), q))) curve.rounding_[c] = q / std::sqrt(12.0);
+    if (options.resolution > 0.0) {
+      curve.rounding_[c] = q / std::sqrt(12.0);
+    } else if (q > 0.0 && IsRounded(z.col(c), q)) {
+      curve.rounding_[c] = internal::RoundingLevel(z.col(c), q, gaps);
+    }
     sigma_floor[c] = curve.rounding_[c];
     if (options.resolution > 0.0 || curve.rounding_[c] == 0.0) continue;
     if (const std::optional<double> placed = internal::PlaceBetweenSteps(t, z.col(c), q, gaps)) {
@@ -1029,6 +1035,10 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     }
   }
   auto floored = [&](Eigen::VectorXd sigma) { return sigma.cwiseMax(sigma_floor).eval(); };
+  // The step of each coordinate whose values were rounded to it and stay so (0: none), for the
+  // noise profile: where the rounding dominates their errors, these change with the speed.
+  Eigen::VectorXd rounded = Eigen::VectorXd::Zero(z.cols());
+  for (Eigen::Index c = 0; c < z.cols(); ++c) rounded[c] = curve.rounding_[c] > 0.0 ? curve.resolution_[c] : 0.0;
 
   // Jumps and glitches (CurveOptions::robust): outliers leave the fit, jumps split it.
   internal::Jumps jumps;
@@ -1044,7 +1054,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     if (!options.noise_sigma) magnitudes.emplace(t, z, gaps, threads);
     noise = options.noise_sigma ? Eigen::VectorXd::Constant(values.cols(), *options.noise_sigma)
                                 : floored(magnitudes->Sigma(0, m));
-    if (magnitudes) before.emplace(noise, *magnitudes, m);
+    if (magnitudes) before.emplace(noise, *magnitudes, m, rounded);
     magnitudes.reset();
     jumps = internal::FindJumps(t, z, gaps, noise, before ? &*before : nullptr, threads);
   }
@@ -1117,7 +1127,7 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   // noisier than the data as a whole.
   const internal::NoiseProfile profile =
       before && !found ? std::move(*before)
-      : magnitudes     ? internal::NoiseProfile(curve.noise_sigma_, *magnitudes, fitted_count)
+      : magnitudes     ? internal::NoiseProfile(curve.noise_sigma_, *magnitudes, fitted_count, rounded)
                        : internal::NoiseProfile(curve.noise_sigma_);
   before.reset();
   magnitudes.reset();

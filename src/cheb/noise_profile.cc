@@ -56,6 +56,13 @@ constexpr Eigen::Index kMinResolutionSteps = 8;
 // 0.69–1.00, and the shared TUM, EuRoC and RPNG files 0.86–0.96; motion that lies on a lattice by
 // itself, only at its corners (a triangle wave of 5 mm steps at 100 Hz: 0.03; constant velocity 0).
 constexpr double kRoundedShare = 0.5;
+// Rounded values (RoundingLevel): the mean square of whole-step 4th differences is taken over at
+// least this many runs, and only where the part of it beyond 4 standard deviations of the median's
+// estimate is at most this share (white noise's: 0.1 %; noise of q/5 before rounding, whose median
+// reads 0 and so winsorizes at 4 standard deviations of q/sqrt(12), under 2 %; EuRoC's and TUM's
+// ground truth: over 80 %).
+constexpr Eigen::Index kMinLevelRuns = 100;
+constexpr double kMaxTailShare = 0.05;
 
 // The bins' variances σ_b² against their mean squared rate u_b, fitted as s_c² + τ²·u_b by least
 // squares weighted by the bins' scatter (iterated on the fitted variances).
@@ -70,7 +77,7 @@ struct SpeedLine {
 // (`middle` samples after its first). nullopt with too few runs, or where either the magnitudes or
 // the rates are zero throughout.
 std::optional<SpeedLine> FitSpeedLine(const Eigen::MatrixXd& magnitudes, const Eigen::MatrixXd& rates,
-                                      Eigen::Index middle, double bin_scatter) {
+                                      Eigen::Index middle, double bin_scatter, const std::vector<bool>& left_out) {
   const Eigen::Index m = magnitudes.rows(), d = magnitudes.cols();
   struct Bin {
     Eigen::Index c;
@@ -81,6 +88,7 @@ std::optional<SpeedLine> FitSpeedLine(const Eigen::MatrixXd& magnitudes, const E
   std::vector<double> scratch;
   runs.reserve(static_cast<size_t>(m));
   for (Eigen::Index c = 0; c < d; ++c) {
+    if (!left_out.empty() && left_out[static_cast<size_t>(c)]) continue;
     runs.clear();
     for (Eigen::Index i = 0; i + middle < m; ++i) {
       const double rate = rates(i + middle, c);
@@ -188,12 +196,14 @@ std::optional<SpeedLine> FitSpeedLine(const Eigen::MatrixXd& magnitudes, const E
 
 }  // namespace
 
-std::optional<StampNoise> FindStampNoise(const DifferenceMagnitudes& magnitudes) {
-  const std::optional<SpeedLine> fourth = FitSpeedLine(magnitudes.fourth(), magnitudes.rates(), 2, kBinScatter4);
+std::optional<StampNoise> FindStampNoise(const DifferenceMagnitudes& magnitudes, const std::vector<bool>& left_out) {
+  const std::optional<SpeedLine> fourth =
+      FitSpeedLine(magnitudes.fourth(), magnitudes.rates(), 2, kBinScatter4, left_out);
   if (!fourth || !(fourth->slope >= kSlopeScore4 * fourth->slope_error) || !(fourth->misfit <= kMaxMisfit)) {
     return std::nullopt;
   }
-  const std::optional<SpeedLine> eighth = FitSpeedLine(magnitudes.eighth(), magnitudes.rates(), 4, kBinScatter8);
+  const std::optional<SpeedLine> eighth =
+      FitSpeedLine(magnitudes.eighth(), magnitudes.rates(), 4, kBinScatter8, left_out);
   if (!eighth || !(eighth->slope >= kSlopeScore8 * eighth->slope_error)) return std::nullopt;
   if (!(eighth->slope <= kOrderAgreement * fourth->slope && fourth->slope <= kOrderAgreement * eighth->slope)) {
     return std::nullopt;
@@ -205,9 +215,18 @@ std::optional<StampNoise> FindStampNoise(const DifferenceMagnitudes& magnitudes)
 
 NoiseProfile::NoiseProfile(const Eigen::VectorXd& level) : level_(level), maximum_(level) {}
 
-NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitudes& magnitudes, Eigen::Index m)
-    : level_(level), maximum_(level), stamp_noise_(FindStampNoise(magnitudes)) {
+NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitudes& magnitudes, Eigen::Index m,
+                           const Eigen::VectorXd& rounded)
+    : level_(level), maximum_(level) {
   const Eigen::Index d = level.size();
+  std::vector<bool> dominated(static_cast<size_t>(d), false);
+  for (Eigen::Index c = 0; c < d; ++c) dominated[static_cast<size_t>(c)] = RoundingDominates(level[c], rounded[c]);
+  stamp_noise_ = FindStampNoise(magnitudes, dominated);
+  if (stamp_noise_) {
+    for (Eigen::Index c = 0; c < d; ++c) {
+      if (dominated[static_cast<size_t>(c)]) stamp_noise_->intercept[c] = level[c] * level[c];
+    }
+  }
   // The variance the blocks are judged against, per sample: the level's, or the stamp noise's.
   // `base` holds the latter's running sums ((m + 1) x d); empty for the level.
   const Eigen::VectorXd level_variance = level.cwiseAbs2();
@@ -345,11 +364,9 @@ double FindResolution(const Eigen::Ref<const Eigen::VectorXd>& z) {
 
 bool IsRounded(const Eigen::Ref<const Eigen::VectorXd>& values, double q) {
   if (!(q > 0.0) || values.size() < 5) return false;
-  // The values as whole numbers of steps from the first (exact: FindResolution put them there).
-  std::vector<double> n(static_cast<size_t>(values.size()));
-  for (Eigen::Index i = 0; i < values.size(); ++i) n[static_cast<size_t>(i)] = std::round((values[i] - values[0]) / q);
+  const Eigen::VectorXd n = internal::WholeSteps(values, q);
   Eigen::Index changing = 0, scattered = 0;
-  for (size_t i = 0; i + 4 < n.size(); ++i) {
+  for (Eigen::Index i = 0; i + 4 < n.size(); ++i) {
     if (n[i] == n[i + 1] && n[i] == n[i + 2] && n[i] == n[i + 3] && n[i] == n[i + 4]) continue;
     ++changing;
     if (n[i] - 4.0 * n[i + 1] + 6.0 * n[i + 2] - 4.0 * n[i + 3] + n[i + 4] != 0.0) ++scattered;
@@ -358,3 +375,44 @@ bool IsRounded(const Eigen::Ref<const Eigen::VectorXd>& values, double q) {
 }
 
 }  // namespace cheval::cheb
+
+namespace cheval::cheb::internal {
+
+Eigen::VectorXd WholeSteps(const Eigen::Ref<const Eigen::VectorXd>& values, double q) {
+  Eigen::VectorXd n(values.size());
+  for (Eigen::Index i = 0; i < values.size(); ++i) n[i] = std::round((values[i] - values[0]) / q);
+  return n;
+}
+
+double RoundingLevel(const Eigen::Ref<const Eigen::VectorXd>& values, double q, const std::vector<Eigen::Index>& breaks) {
+  const double floor = q / std::sqrt(12.0);
+  const Eigen::VectorXd n = WholeSteps(values, q);
+  // The 4th differences of the runs of five that no break crosses, in steps.
+  std::vector<double> fourth;
+  fourth.reserve(static_cast<size_t>(n.size()));
+  size_t next = 0;  // the first break at or after the run's first sample
+  for (Eigen::Index i = 0; i + 4 < n.size(); ++i) {
+    while (next < breaks.size() && breaks[next] < i) ++next;
+    if (next < breaks.size() && breaks[next] < i + 4) continue;
+    fourth.push_back(std::abs(n[i] - 4.0 * n[i + 1] + 6.0 * n[i + 2] - 4.0 * n[i + 3] + n[i + 4]));
+  }
+  const auto runs = static_cast<double>(fourth.size());
+  if (fourth.size() < static_cast<size_t>(kMinLevelRuns)) return floor;
+  double square = 0.0;
+  for (const double f : fourth) square += f * f;
+  square /= runs;
+  // White noise's 4th differences have 70 times its variance.
+  const double scale = std::sqrt(70.0);
+  std::vector<double> scratch = fourth;
+  const double median = kMadScale * SelectNonNegative(&scratch, scratch.size() / 2) / scale;  // σ in steps
+  const double start = std::max(median, 1.0 / std::sqrt(12.0));
+  if (!(start < 1.0 / std::sqrt(3.0))) return floor;
+  const double clip = 4.0 * scale * start;
+  double winsorized = 0.0;
+  for (const double f : fourth) winsorized += std::min(f, clip) * std::min(f, clip);
+  winsorized /= runs;
+  if (square > (1.0 + kMaxTailShare) * winsorized) return floor;
+  return std::max(floor, q * std::sqrt(square / 70.0));
+}
+
+}  // namespace cheval::cheb::internal

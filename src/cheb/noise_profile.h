@@ -78,8 +78,33 @@ struct StampNoise {
 /// of speed lies on a line in the squared rate, steeply enough to be told from the bins' scatter,
 /// and the 8th differences' slope agrees (motion's leak into them grows with the speed too, but
 /// falls with the order, while white noise's does not). nullopt where they do not, and below a few
-/// hundred samples.
-std::optional<StampNoise> FindStampNoise(const DifferenceMagnitudes& magnitudes);
+/// hundred samples. Coordinates marked in `left_out` (empty: none) take no part: their errors
+/// change with the speed for another reason (RoundingDominates), and their intercept is 0.
+std::optional<StampNoise> FindStampNoise(const DifferenceMagnitudes& magnitudes,
+                                         const std::vector<bool>& left_out = {});
+
+/// The values of a coordinate on a lattice of step q, as whole numbers of steps from the first
+/// (exact: FindResolution put them there).
+Eigen::VectorXd WholeSteps(const Eigen::Ref<const Eigen::VectorXd>& values, double q);
+
+/// The noise σ of values rounded to steps of q (cheb::IsRounded) that the fit floors an estimate
+/// at: q/sqrt(12), or more where the noise added before the rounding shows. Rounding x + n, n white
+/// of σ_n, errs by u + n with u uniform over a step and independent of n wherever the motion
+/// crosses many steps, so the values' noise is sqrt(q²/12 + σ_n²). Where σ_n is below about q/2
+/// the median of their whole-step 4th differences is a few steps at most and reads it coarsely (0,
+/// 0.18, 0.35, … steps; noise of q/5 before rounding slow motion: 0 for a noise of 0.35·q), while
+/// their mean square reads it to a few per cent: it is taken where the median reads below q/sqrt(3)
+/// and the differences have no tails beyond 4 of the median's standard deviations (mean square
+/// within kMaxTailShare of the one with those winsorized; EuRoC's and TUM's ground truth, whose
+/// tails are motion and glitches, keep q/sqrt(12)). `breaks`: boundaries b (between samples b and
+/// b + 1) no difference is taken across.
+double RoundingLevel(const Eigen::Ref<const Eigen::VectorXd>& values, double q, const std::vector<Eigen::Index>& breaks);
+
+/// Whether a coordinate rounded to steps of q (0: none) at noise level `sigma` has errors the
+/// rounding dominates: σ below q/sqrt(3), the values' noise with white noise of q/2 before the
+/// rounding, below which the rounding's errors change with the motion's speed (a staircase where it
+/// is slow, white where it is fast). Its differences growing with the speed say nothing of stamps.
+inline bool RoundingDominates(double sigma, double q) { return q > 0.0 && sigma < q / std::sqrt(3.0); }
 
 /// Whether a noise σ (a profile's RMS over some samples) is the rounding's, `rounding` =
 /// q/sqrt(12) from cheb::FindResolution (0: none), to which an estimate was floored: the differences
@@ -109,7 +134,11 @@ class NoiseProfile {
   /// The level, raised where the samples' `magnitudes` say they are noisier. Where they show stamp
   /// noise (FindStampNoise), its σ_c(i) takes the level's place, and is raised by the same rules
   /// against its own RMS.
-  NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitudes& magnitudes, Eigen::Index m);
+  /// `rounded` per coordinate: the step its values were rounded to (0: none); coordinates whose
+  /// errors the rounding dominates (RoundingDominates) are left out of the search for stamp noise,
+  /// and keep their level under it.
+  NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitudes& magnitudes, Eigen::Index m,
+               const Eigen::VectorXd& rounded);
 
   /// The root mean square of σ over samples [first, first + count), per coordinate.
   Eigen::VectorXd Over(Eigen::Index first, Eigen::Index count) const;

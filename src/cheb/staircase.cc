@@ -1,5 +1,7 @@
 #include "staircase.h"
 
+#include "noise_profile.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -85,10 +87,8 @@ std::optional<double> PlaceBetweenSteps(const Eigen::Ref<const Eigen::VectorXd>&
                                         double q, const std::vector<Eigen::Index>& breaks) {
   const Eigen::Index m = z.size();
   if (m < 5 || !(q > 0.0)) return std::nullopt;
-  // The values as whole numbers of steps from the first (exact: FindResolution put them there).
   const double origin = z[0];
-  Eigen::VectorXd steps(m);
-  for (Eigen::Index i = 0; i < m; ++i) steps[i] = std::round((z[i] - origin) / q);
+  const Eigen::VectorXd steps = WholeSteps(z, q);
 
   // Stretches [begin, end] between the breaks.
   std::vector<std::pair<Eigen::Index, Eigen::Index>> stretches;

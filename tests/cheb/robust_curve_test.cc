@@ -18,6 +18,7 @@
 
 #include "cheval/cheb/curve.h"
 #include "cheval/cheb/degree.h"
+#include "noise_profile.h"
 #include "staircase.h"
 #include "synthetic_motion.h"
 
@@ -650,6 +651,85 @@ TEST(RoundedPositions, OnlyACleanStaircaseIsPlaced) {
     }
     const Curve curve = FitCurve(s->stamps, rounded);
     for (Eigen::Index c = 0; c < 3; ++c) EXPECT_FALSE(curve.staircase()[static_cast<size_t>(c)]) << c;
+  }
+}
+
+// Noise added before the rounding (σ_n, a fifth and three tenths of the step) on the slow motion
+// above at 1000 Hz: the values' noise is about sqrt(q²/12 + σ_n²) (the rounding errs by u, uniform
+// over a step and independent of the noise, wherever the motion crosses many steps). The median of
+// the whole-step 4th differences reads 0 or 0.35·q, and the level was q/sqrt(12): 0.83 and 0.70 of
+// the values' noise, and the velocity followed the flips (58 and 255 mm/s). The mean square of
+// those differences reads it: 0.95 and 0.99 of it (a fifth of the step dithers the rounding only
+// partly, and its errors stay correlated over part of a step, which the differences see less of).
+TEST(RoundedPositions, NoiseBeforeTheRoundingAddsToIt) {
+  auto slow = [](double t, Eigen::Vector3d* p, Eigen::Vector3d* v) {
+    Smooth(t, p, v);
+    *p *= 0.1;
+    *v *= 0.1;
+  };
+  const double q = 1e-3;
+  for (const double before : {0.2e-3, 0.3e-3}) {
+    Motion s = Sample(slow, 20.0, 1000.0, before, 0.0, 4);
+    s.positions = Printed(s.positions, 3);
+    const Eigen::MatrixXd error = s.positions - Sample(slow, 20.0, 1000.0, 0.0, 0.0, 4).positions;
+    const Curve curve = FitCurve(s.stamps, s.positions);
+    for (Eigen::Index c = 0; c < 3; ++c) {
+      const double actual = std::sqrt(error.col(c).squaredNorm() / static_cast<double>(error.rows()));
+      EXPECT_NEAR(actual, std::sqrt(q * q / 12.0 + before * before), 0.05 * actual) << before << ", " << c;
+      const double level = internal::RoundingLevel(s.positions.col(c), q, {});
+      EXPECT_GT(level, 0.92 * actual) << before << ", coordinate " << c;
+      EXPECT_LT(level, 1.05 * actual) << before << ", coordinate " << c;
+      EXPECT_GT(curve.noise_sigma()[c], 0.92 * actual) << before << ", coordinate " << c;
+      EXPECT_FALSE(curve.staircase()[static_cast<size_t>(c)]) << before << ", coordinate " << c;
+    }
+    const double fit = VelocityRmse(curve, s), central = CentralRmse(s);
+    EXPECT_LT(fit, 0.01 * central) << before;
+    EXPECT_LT(fit, 1e-3) << before;  // 0.53 and 0.03 mm/s
+  }
+}
+
+// Three tones of 6, 2 and 0.6 mm at 0.3, 1.1 and 2.7 Hz (up to 34 mm/s) at 1000 Hz, with noise of
+// 0.3 mm before rounding to the millimetre: the values' differences grow with the speed, as the
+// rounding goes from a staircase to white, and on the 4th and 8th differences alike, as stamp noise
+// would (FindStampNoise finds 1.4 ms). A coordinate whose noise the rounding dominates takes no part
+// in that search (RoundingDominates): before, the velocity followed that stamp noise.
+TEST(RoundedPositions, TheirNoiseGrowingWithTheSpeedIsNotTheStamps) {
+  auto tones = [](double t, Eigen::Vector3d* p, Eigen::Vector3d* v) {
+    p->setZero();
+    v->setZero();
+    const double frequency[] = {0.3, 1.1, 2.7}, amplitude[] = {6e-3, 2e-3, 0.6e-3};
+    for (int c = 0; c < 3; ++c) {
+      for (int k = 0; k < 3; ++k) {
+        const double w = 2.0 * M_PI * frequency[k], phase = 1.0 + 0.7 * c + 1.9 * k;
+        (*p)[c] += amplitude[k] * std::sin(w * t + phase);
+        (*v)[c] += amplitude[k] * w * std::cos(w * t + phase);
+      }
+    }
+  };
+  const double q = 1e-3;
+  Motion s = Sample(tones, 20.0, 1000.0, 0.3e-3, 0.0, 6);
+  s.positions = Printed(s.positions, 3);
+  const Eigen::Index m = s.t.size();
+  const internal::DifferenceMagnitudes magnitudes(s.t, s.positions, {});
+  Eigen::VectorXd level(3);
+  for (Eigen::Index c = 0; c < 3; ++c) level[c] = internal::RoundingLevel(s.positions.col(c), q, {});
+  EXPECT_TRUE(internal::FindStampNoise(magnitudes).has_value());
+  EXPECT_FALSE(internal::NoiseProfile(level, magnitudes, m, Eigen::Vector3d::Constant(q)).stamp_noise().has_value());
+  const Curve curve = FitCurve(s.stamps, s.positions);
+  EXPECT_EQ(curve.stamp_noise_s(), 0.0);
+  EXPECT_LT(VelocityRmse(curve, s), 3e-3);  // 1.8 mm/s; 111 mm/s before
+}
+
+// Rounded values whose differences have tails (glitches, motion the differences do not remove:
+// EuRoC's and TUM's ground truth) keep the rounding's q/sqrt(12): a mean of squares would read the
+// tails as noise. White rounding of noise-free motion, two single-sample glitches of 20 steps in a
+// thousand samples.
+TEST(RoundedPositions, TailsAreNotTheNoiseBeforeTheRounding) {
+  const Motion s = Sample(Smooth, 20.0, 50.0, 0.0, 0.0, 5);
+  Eigen::MatrixXd rounded = Printed(s.positions, 3);
+  for (Eigen::Index i = 100; i < rounded.rows(); i += 500) rounded.row(i).array() += 20e-3;
+  for (Eigen::Index c = 0; c < 3; ++c) {
+    EXPECT_EQ(internal::RoundingLevel(rounded.col(c), 1e-3, {}), 1e-3 / std::sqrt(12.0)) << c;
   }
 }
 

@@ -55,8 +55,8 @@ struct CurveOptions {
   /// Noise standard deviation of the samples (same unit as them); nullopt = estimated from the data.
   std::optional<double> noise_sigma;
   /// The step the values were rounded to, where the caller knows it; 0: per coordinate, the
-  /// lattice the values lie on, if any (FindResolution). An estimated σ is at least step/sqrt(12)
-  /// (docs/velocity.md, "Rounded positions"). Rotation charts of rounded quaternions lie on no
+  /// lattice the values lie on, if any (FindResolution). An estimated σ is at least step/sqrt(12),
+  /// more where noise was added before the rounding (docs/velocity.md, "Rounded positions"). Rotation charts of rounded quaternions lie on no
   /// lattice of their own, and take it from the quaternions' (eval::EstimateVelocity). A found
   /// lattice floors σ only where the values were rounded to it (IsRounded); a given one always.
   double resolution = 0.0;
@@ -246,11 +246,12 @@ class Curve {
   double stamp_noise_s() const { return stamp_noise_s_; }
   /// Per coordinate, the step q the values were rounded to, 0 where they were not (docs/velocity.md,
   /// "Rounded positions"). Where they were rounded to it (IsRounded), an estimated noise σ is at
-  /// least q/sqrt(12), the rounding's.
+  /// least the rounding's: q/sqrt(12), and sqrt(q²/12 + σ_n²) where the mean square of their
+  /// differences shows noise σ_n added before the rounding.
   const Eigen::VectorXd& resolution() const { return resolution_; }
   /// Whether coordinate c's estimated noise σ is the rounding's: its values were rounded, and the
-  /// differences read less noise than the rounding (a staircase, or a median of 4th differences
-  /// that is itself a whole number of steps).
+  /// median of their differences reads less noise than the rounding makes (a staircase, or a median
+  /// of 4th differences that is itself a whole number of steps).
   bool AtRounding(Eigen::Index c) const;
   /// Per coordinate, whether its values were rounded to a step they moved less than a sample at a
   /// time (a staircase), and were fitted placed between their steps: on a curve through the
@@ -304,7 +305,7 @@ class Curve {
   Eigen::VectorXd noise_sigma_max_;  // empty: noise_sigma_
   double stamp_noise_s_ = 0.0;
   Eigen::VectorXd resolution_;  // per coordinate, 0: not rounded
-  Eigen::VectorXd rounding_;    // per coordinate, the floor of σ (q/sqrt(12), or a staircase's), 0: none
+  Eigen::VectorXd rounding_;    // per coordinate, the rounding's σ flooring an estimate, 0: none (or placed)
   std::vector<bool> staircase_;  // per coordinate, placed between its steps
   Eigen::VectorXd residual_rms_;
   std::vector<double> outlier_times_, jump_times_, step_times_;
