@@ -332,7 +332,7 @@
       ['degrees', `${Math.min(...degrees)} .. ${Math.max(...degrees)}`],
       ['noise σ (estimated)', f.noise_sigma.map((s) => s.toExponential(2) + ' m').join(', ')
         + (f.noisier_samples > 0 ? ` (up to ${f.noise_sigma_max.map((s) => s.toExponential(2)).join(', ')} m over ${f.noisier_samples} noisier samples)` : '')],
-      ...((f.at_rounding || []).some((a) => a) ? [['rounded positions', `${f.resolution.map((q, c) => (f.at_rounding[c] ? `${'xyz'[c]} to ${(1e3 * q).toPrecision(3)} mm` : null)).filter((x) => x).join(', ')}: their differences read no more noise than the rounding's, step/√12, which the fit takes as their noise`]] : []),
+      ...((f.at_rounding || []).some((a) => a) ? [['rounded positions', `${f.resolution.map((q, c) => (f.at_rounding[c] ? `${'xyz'[c]} to ${(1e3 * q).toPrecision(3)} mm` : null)).filter((x) => x).join(', ')}: their differences read no more noise than the rounding makes, step/√12 with any noise before it, which the fit takes as their noise`]] : []),
       ...((f.staircase || []).some((a) => a) ? [['rounded positions, placed', `${f.resolution.map((q, c) => (f.staircase[c] ? `${'xyz'[c]} to ${(1e3 * q).toPrecision(3)} mm` : null)).filter((x) => x).join(', ')}: they move less than a step a sample, and were placed between their steps, on a curve through the instants they pass from one step to the next`]] : []),
       ...(f.stamp_noise_s > 0 ? [['stamp noise', `the samples scatter in proportion to their rate, as stamps off by ${(1e3 * f.stamp_noise_s).toPrecision(3)} ms (RMS) make them; the fit takes that noise into account`]] : []),
       ['fit residual RMS', f.residual_rms.map((s) => s.toExponential(2) + ' m').join(', ')],

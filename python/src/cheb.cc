@@ -111,7 +111,8 @@ Raises ComputeError for a stamp outside the data by more than `tolerance` second
                              "\"Stamp noise\").")
       .def_property_readonly("resolution", &cheb::Curve::resolution,
                              "Per coordinate, the step the values were rounded to (0 where they were not); an "
-                             "estimated noise sigma is at least step/sqrt(12), except on a staircase (docs/velocity.md, "
+                             "estimated noise sigma is at least step/sqrt(12), more with noise before the rounding, "
+                             "except on a staircase (docs/velocity.md, "
                              "\"Rounded positions\").")
       .def_property_readonly("staircase", &cheb::Curve::staircase,
                              "Per coordinate, whether the values were rounded to a step they moved less than a "

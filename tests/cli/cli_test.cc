@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -251,6 +252,43 @@ TEST_F(CliTest, VelocityOfRoundedPositionsSaysSo) {
   RunResult plain = Cheval("velocity " + Path("rt.txt") + " --format tumv -o " + Path("rp.txt"));
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
   EXPECT_EQ(plain.err.find("rounded"), std::string::npos) << plain.err;
+}
+
+// The same motion with white noise of 0.3 mm added before the rounding: the note gives the noise the
+// fit took, sqrt(q²/12 + 0.3²) = 0.42 mm, not the rounding's 0.29 (docs/velocity.md, "Noise before
+// the rounding").
+TEST_F(CliTest, VelocityOfRoundedNoisyPositionsSaysTheirNoise) {
+  std::ofstream measured(Path("n.txt")), truth(Path("nt.txt"));
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.3e-3);
+  for (int i = 0; i < 5000; ++i) {
+    const double t = 100.0 + i / 500.0;
+    const double p[3] = {0.05 * std::sin(0.5 * t), 0.03 * std::cos(0.4 * t), 0.02 * std::sin(0.3 * t)};
+    const double v[3] = {0.025 * std::cos(0.5 * t), -0.012 * std::sin(0.4 * t), 0.006 * std::cos(0.3 * t)};
+    measured << fmt::format("{:.4f} {:.3f} {:.3f} {:.3f} 0 0 0 1\n", t, p[0] + noise(rng), p[1] + noise(rng),
+                            p[2] + noise(rng));
+    truth << fmt::format("{:.4f} {} {} {} 0 0 0 1 {} {} {}\n", t, p[0], p[1], p[2], v[0], v[1], v[2]);
+  }
+  measured.close();
+  truth.close();
+  RunResult run = Cheval("velocity " + Path("n.txt") + " -o " + Path("nv.txt") + " --json " + Path("nv.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(Slurp(Path("nv.json")));
+  EXPECT_NE(run.err.find(fmt::format("the positions are rounded (x to 1 mm: noise {:.3g} mm, y to 1 mm: noise",
+                                     1e3 * j["noise_sigma_m"][0].get<double>())),
+            std::string::npos)
+      << run.err;
+  EXPECT_NE(run.err.find("step/sqrt(12) with any noise before it"), std::string::npos) << run.err;
+  const double expected = std::sqrt(1e-6 / 12.0 + 0.09e-6);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_FALSE(j["position_staircase"][c].get<bool>());
+    EXPECT_NEAR(j["noise_sigma_m"][c].get<double>(), expected, 0.06 * expected) << c;
+  }
+  EXPECT_EQ(j["stamp_noise_s"].get<double>(), 0.0);
+  RunResult central = Cheval("velocity " + Path("n.txt") + " --method central -o " + Path("nc.txt"));
+  ASSERT_EQ(central.exit_code, 0) << central.err;
+  const double cheb = VelocityRmse(Path("nv.txt"), Path("nt.txt")), diff = VelocityRmse(Path("nc.txt"), Path("nt.txt"));
+  EXPECT_LT(cheb, 0.01 * diff) << cheb << " vs central " << diff;
 }
 
 // The first column (stamps in seconds) of a TUM file, comments skipped.

@@ -121,11 +121,12 @@ void Run(const VelocityFlags& flags) {
     std::string* list = curve.staircase()[static_cast<size_t>(c)] ? &staircase : curve.AtRounding(c) ? &at_rounding : nullptr;
     if (list == nullptr) continue;
     *list += fmt::format("{}{} to {:.3g} mm", list->empty() ? "" : ", ", "xyz"[c], 1e3 * curve.resolution()[c]);
+    if (list == &at_rounding) *list += fmt::format(": noise {:.3g} mm", 1e3 * curve.noise_sigma()[c]);
   }
   if (!at_rounding.empty()) {
     fmt::print(stderr, "cheval: note: {}: the positions are rounded ({}) and their differences read no more noise than "
-               "that rounding's, step/sqrt(12): the fit takes it as their noise, and a staircase of them is not taken "
-               "for motion (docs/velocity.md, \"Rounded positions\")\n",
+               "that rounding makes, step/sqrt(12) with any noise before it: the fit takes that as their noise, and a "
+               "staircase of them is not taken for motion (docs/velocity.md, \"Rounded positions\")\n",
                flags.input, at_rounding);
   }
   if (!staircase.empty()) {
