@@ -244,12 +244,16 @@ Case StampErrors() {
 
 // Positions written to the millimetre of a slow motion (the handheld one at a tenth of its size
 // and speed) at 1000 Hz: a staircase, about 30 samples a step, whose differences read no noise
-// (docs/velocity.md, "Rounded positions").
-Case RoundedSlow() {
+// (docs/velocity.md, "Rounded positions"). With `before`, white noise of that σ added before the
+// rounding: the steps' edges flip back and forth, and the values' noise is about
+// sqrt(step²/12 + before²).
+Case RoundedSlow(double before) {
   const sim::MotionModel model = Handheld(1000);
-  const traj::Trajectory taken = sim::Measure(model, sim::MeasurementOptions{});
+  sim::MeasurementOptions measurement;
+  measurement.noise_m = before / 0.1;  // a tenth of it once shrunk
+  const traj::Trajectory taken = sim::Measure(model, measurement);
   Case c;
-  c.name = "rounded 1 mm, slow";
+  c.name = before > 0.0 ? fmt::format("rounded 1 mm, slow, {:.1f} mm", 1e3 * before) : "rounded 1 mm, slow";
   c.truth = 0.1 * sim::SampleMotion(model, taken.stamps_ns()).View().velocities();
   c.measured.Reserve(taken.size());
   for (Eigen::Index i = 0; i < taken.size(); ++i) {
@@ -332,8 +336,8 @@ int main(int argc, char** argv) {
       }
     }
   }
-  for (const Case& c : {Tremor(0.0005), Tremor(0.0), Impacts(), Vibration(), Bursts(), StampErrors(), RoundedSlow(),
-                        ShortClip()}) {
+  for (const Case& c : {Tremor(0.0005), Tremor(0.0), Impacts(), Vibration(), Bursts(), StampErrors(), RoundedSlow(0.0),
+                        RoundedSlow(0.3e-3), ShortClip()}) {
     if (wanted(c.name)) Print(Evaluate(c.name, c.measured.View(), c.truth));
   }
   for (const char* file : {"MH_05_difficult.csv", "V1_01_easy.csv", "V1_02_medium.csv", "V2_02_medium.csv"}) {
