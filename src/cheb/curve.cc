@@ -1008,12 +1008,11 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
   // (a staircase: motion slower than a step a sample), and more with noise added before the
   // rounding, which the median of whole-step differences reads coarsely (RoundingLevel); an
   // estimate is floored where they were rounded, not where exact motion lies on a lattice by
-  // itself (IsRounded). A clean staircase is
-  // placed between its steps instead (PlaceBetweenSteps), and its floor is how well its crossings
-  // predict each other. Its errors are no longer the rounding's, so the rounding's two-sided
-  // degree test is not made on it (curve.rounding_ is 0 there); the local regression leaves it
-  // alone all the same (curve.staircase_). A step given by the caller is not one the values need
-  // lie on, and they are left as they are.
+  // itself (IsRounded). A clean staircase is placed between its steps instead (PlaceBetweenSteps),
+  // and its floor is how well its crossings predict each other. Its errors are no longer the
+  // rounding's, so the rounding's two-sided degree test is not made on it (curve.rounding_ is 0
+  // there); the local regression leaves it alone all the same (curve.staircase_). A step given by
+  // the caller is not one the values need lie on, and they are left as they are.
   curve.resolution_ = Eigen::VectorXd::Zero(z.cols());
   curve.rounding_ = Eigen::VectorXd::Zero(z.cols());
   curve.staircase_.assign(static_cast<size_t>(z.cols()), false);

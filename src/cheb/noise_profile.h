@@ -95,10 +95,11 @@ Eigen::VectorXd WholeSteps(const Eigen::Ref<const Eigen::VectorXd>& values, doub
 /// 0.18, 0.35, … steps; noise of q/5 before rounding slow motion: 0 for a noise of 0.35·q), while
 /// their mean square reads it to a few per cent: it is taken where the median reads below q/sqrt(3)
 /// and the differences have no tails beyond 4 of the median's standard deviations (mean square
-/// within kMaxTailShare of the one with those winsorized; EuRoC's and TUM's ground truth, whose
-/// tails are motion and glitches, keep q/sqrt(12)). `breaks`: boundaries b (between samples b and
-/// b + 1) no difference is taken across.
-double RoundingLevel(const Eigen::Ref<const Eigen::VectorXd>& values, double q, const std::vector<Eigen::Index>& breaks);
+/// within kMaxTailShare of the one with those winsorized). EuRoC's and TUM's ground truth keep
+/// q/sqrt(12): their medians read above q/sqrt(3), or their tails (motion and glitches) are heavy.
+/// `breaks`: boundaries b (between samples b and b + 1) no difference is taken across.
+double RoundingLevel(const Eigen::Ref<const Eigen::VectorXd>& values, double q,
+                     const std::vector<Eigen::Index>& breaks);
 
 /// Whether a coordinate rounded to steps of q (0: none) at noise level `sigma` has errors the
 /// rounding dominates: σ below q/sqrt(3), the values' noise with white noise of q/2 before the

@@ -56,9 +56,10 @@ struct CurveOptions {
   std::optional<double> noise_sigma;
   /// The step the values were rounded to, where the caller knows it; 0: per coordinate, the
   /// lattice the values lie on, if any (FindResolution). An estimated σ is at least step/sqrt(12),
-  /// more where noise was added before the rounding (docs/velocity.md, "Rounded positions"). Rotation charts of rounded quaternions lie on no
-  /// lattice of their own, and take it from the quaternions' (eval::EstimateVelocity). A found
-  /// lattice floors σ only where the values were rounded to it (IsRounded); a given one always.
+  /// more where noise was added before the rounding (docs/velocity.md, "Rounded positions").
+  /// Rotation charts of rounded quaternions lie on no lattice of their own, and take it from the
+  /// quaternions' (eval::EstimateVelocity). A found lattice floors σ only where the values were
+  /// rounded to it (IsRounded); a given one always.
   double resolution = 0.0;
   /// The derivative of a least-squares polynomial is noisiest at the ends of its interval, and
   /// more so the higher its degree (the variance at an end grows like N⁴/m). The first and last
