@@ -1050,12 +1050,15 @@ Curve FitCurve(std::span<const int64_t> stamps_ns, const Eigen::Ref<const Eigen:
     curve.resolution_[c] = q;
     if (options.resolution > 0.0) {
       curve.rounding_[c] = q / std::sqrt(12.0);
-    } else if (q > 0.0 && IsRounded(z.col(c), q)) {
-      curve.rounding_[c] = internal::RoundingLevel(z.col(c), q, gaps);
+      sigma_floor[c] = curve.rounding_[c];
+      continue;
     }
+    if (!(q > 0.0) || z.rows() < 5) continue;
+    const Eigen::VectorXd steps = internal::WholeSteps(z.col(c), q);
+    if (!internal::IsRoundedSteps(steps)) continue;
+    curve.rounding_[c] = internal::RoundingLevel(steps, q, gaps);
     sigma_floor[c] = curve.rounding_[c];
-    if (options.resolution > 0.0 || curve.rounding_[c] == 0.0) continue;
-    if (const std::optional<double> placed = internal::PlaceBetweenSteps(t, z.col(c), q, gaps)) {
+    if (const std::optional<double> placed = internal::PlaceBetweenSteps(t, z.col(c), steps, q, gaps)) {
       sigma_floor[c] = *placed;
       curve.rounding_[c] = 0.0;
       curve.staircase_[static_cast<size_t>(c)] = true;

@@ -363,20 +363,22 @@ double FindResolution(const Eigen::Ref<const Eigen::VectorXd>& z) {
 }
 
 bool IsRounded(const Eigen::Ref<const Eigen::VectorXd>& values, double q) {
-  if (!(q > 0.0) || values.size() < 5) return false;
-  const Eigen::VectorXd n = internal::WholeSteps(values, q);
+  return q > 0.0 && values.size() >= 5 && internal::IsRoundedSteps(internal::WholeSteps(values, q));
+}
+
+}  // namespace cheval::cheb
+
+namespace cheval::cheb::internal {
+
+bool IsRoundedSteps(const Eigen::VectorXd& n) {
   Eigen::Index changing = 0, scattered = 0;
   for (Eigen::Index i = 0; i + 4 < n.size(); ++i) {
     if (n[i] == n[i + 1] && n[i] == n[i + 2] && n[i] == n[i + 3] && n[i] == n[i + 4]) continue;
     ++changing;
     if (n[i] - 4.0 * n[i + 1] + 6.0 * n[i + 2] - 4.0 * n[i + 3] + n[i + 4] != 0.0) ++scattered;
   }
-  return changing > 0 && static_cast<double>(scattered) >= internal::kRoundedShare * static_cast<double>(changing);
+  return changing > 0 && static_cast<double>(scattered) >= kRoundedShare * static_cast<double>(changing);
 }
-
-}  // namespace cheval::cheb
-
-namespace cheval::cheb::internal {
 
 Eigen::VectorXd WholeSteps(const Eigen::Ref<const Eigen::VectorXd>& values, double q) {
   Eigen::VectorXd n(values.size());
@@ -384,10 +386,8 @@ Eigen::VectorXd WholeSteps(const Eigen::Ref<const Eigen::VectorXd>& values, doub
   return n;
 }
 
-double RoundingLevel(const Eigen::Ref<const Eigen::VectorXd>& values, double q,
-                     const std::vector<Eigen::Index>& breaks) {
+double RoundingLevel(const Eigen::VectorXd& n, double q, const std::vector<Eigen::Index>& breaks) {
   const double floor = q / std::sqrt(12.0);
-  const Eigen::VectorXd n = WholeSteps(values, q);
   // The 4th differences of the runs of five that no break crosses, in steps.
   std::vector<double> fourth;
   fourth.reserve(static_cast<size_t>(n.size()));

@@ -84,8 +84,12 @@ std::optional<StampNoise> FindStampNoise(const DifferenceMagnitudes& magnitudes,
                                          const std::vector<bool>& left_out = {});
 
 /// The values of a coordinate on a lattice of step q, as whole numbers of steps from the first
-/// (exact: FindResolution put them there).
+/// (exact: FindResolution put them there). FitCurve takes them once per coordinate for the
+/// three uses below.
 Eigen::VectorXd WholeSteps(const Eigen::Ref<const Eigen::VectorXd>& values, double q);
+
+/// cheb::IsRounded on the values' whole steps (WholeSteps).
+bool IsRoundedSteps(const Eigen::VectorXd& steps);
 
 /// The noise σ of values rounded to steps of q (cheb::IsRounded) that the fit floors an estimate
 /// at: q/sqrt(12), or more where the noise added before the rounding shows. Rounding x + n, n white
@@ -97,9 +101,9 @@ Eigen::VectorXd WholeSteps(const Eigen::Ref<const Eigen::VectorXd>& values, doub
 /// and the differences have no tails beyond 4 of the median's standard deviations (mean square
 /// within kMaxTailShare of the one with those winsorized). EuRoC's and TUM's ground truth keep
 /// q/sqrt(12): their medians read above q/sqrt(3), or their tails (motion and glitches) are heavy.
-/// `breaks`: boundaries b (between samples b and b + 1) no difference is taken across.
-double RoundingLevel(const Eigen::Ref<const Eigen::VectorXd>& values, double q,
-                     const std::vector<Eigen::Index>& breaks);
+/// `steps`: the values in whole steps (WholeSteps); `breaks`: boundaries b (between samples b and
+/// b + 1) no difference is taken across.
+double RoundingLevel(const Eigen::VectorXd& steps, double q, const std::vector<Eigen::Index>& breaks);
 
 /// Whether a coordinate rounded to steps of q (0: none) at noise level `sigma` has errors the
 /// rounding dominates: σ below q/sqrt(3), the values' noise with white noise of q/2 before the

@@ -84,11 +84,11 @@ Crossing EndOf(const Crossing& edge, double end, double step) {
 }  // namespace
 
 std::optional<double> PlaceBetweenSteps(const Eigen::Ref<const Eigen::VectorXd>& t, Eigen::Ref<Eigen::VectorXd> z,
-                                        double q, const std::vector<Eigen::Index>& breaks) {
+                                        const Eigen::VectorXd& steps, double q,
+                                        const std::vector<Eigen::Index>& breaks) {
   const Eigen::Index m = z.size();
   if (m < 5 || !(q > 0.0)) return std::nullopt;
   const double origin = z[0];
-  const Eigen::VectorXd steps = WholeSteps(z, q);
 
   // Stretches [begin, end] between the breaks.
   std::vector<std::pair<Eigen::Index, Eigen::Index>> stretches;

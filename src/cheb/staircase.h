@@ -22,13 +22,15 @@ namespace cheval::cheb::internal {
 /// 1000 Hz: ~30 samples a step) those crossings fix the motion to a few percent of the step, where
 /// the rounded values err by q/sqrt(12) with errors correlated over a whole step.
 ///
-/// `t` ascending; `z` the values in steps of q from FindResolution; `breaks` the boundaries b
+/// `t` ascending; `z` the values on the lattice of step q from FindResolution and `steps` the same
+/// in whole steps (WholeSteps(z, q)); `breaks` the boundaries b
 /// (between samples b and b + 1) no curve is drawn across (gaps). Only a clean staircase
 /// qualifies: at least 75 % of the differences zero (a step lasts four samples or more on
 /// average), nearly all others one step, and few of them undone by the next, very few within a
 /// few samples (noise at a step's edge flips the values back and forth, and the instants of those
 /// flips are the noise's).
 std::optional<double> PlaceBetweenSteps(const Eigen::Ref<const Eigen::VectorXd>& t, Eigen::Ref<Eigen::VectorXd> z,
-                                        double q, const std::vector<Eigen::Index>& breaks);
+                                        const Eigen::VectorXd& steps, double q,
+                                        const std::vector<Eigen::Index>& breaks);
 
 }  // namespace cheval::cheb::internal

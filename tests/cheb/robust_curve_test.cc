@@ -604,7 +604,8 @@ TEST(RoundedPositions, AStaircaseIsPlacedBetweenItsSteps) {
   const double q = 1e-3;
   for (Eigen::Index c = 0; c < 3; ++c) {
     Eigen::VectorXd placed = rounded.col(c);
-    const std::optional<double> sigma = internal::PlaceBetweenSteps(s.t, placed, q, {});
+    const Eigen::VectorXd steps = internal::WholeSteps(placed, q);
+    const std::optional<double> sigma = internal::PlaceBetweenSteps(s.t, placed, steps, q, {});
     ASSERT_TRUE(sigma.has_value()) << c;
     EXPECT_LE((placed - rounded.col(c)).cwiseAbs().maxCoeff(), 0.5 * q * (1.0 + 1e-9)) << c;
     const Eigen::VectorXd error = placed - s.positions.col(c);
@@ -646,7 +647,8 @@ TEST(RoundedPositions, OnlyACleanStaircaseIsPlaced) {
     const Eigen::MatrixXd rounded = Printed(s->positions, 3);
     for (Eigen::Index c = 0; c < 3; ++c) {
       Eigen::VectorXd values = rounded.col(c);
-      EXPECT_FALSE(internal::PlaceBetweenSteps(s->t, values, 1e-3, {}).has_value()) << c;
+      const Eigen::VectorXd steps = internal::WholeSteps(values, 1e-3);
+      EXPECT_FALSE(internal::PlaceBetweenSteps(s->t, values, steps, 1e-3, {}).has_value()) << c;
       EXPECT_EQ(values, rounded.col(c)) << c;
     }
     const Curve curve = FitCurve(s->stamps, rounded);
@@ -676,7 +678,7 @@ TEST(RoundedPositions, NoiseBeforeTheRoundingAddsToIt) {
     for (Eigen::Index c = 0; c < 3; ++c) {
       const double actual = std::sqrt(error.col(c).squaredNorm() / static_cast<double>(error.rows()));
       EXPECT_NEAR(actual, std::sqrt(q * q / 12.0 + before * before), 0.05 * actual) << before << ", " << c;
-      const double level = internal::RoundingLevel(s.positions.col(c), q, {});
+      const double level = internal::RoundingLevel(internal::WholeSteps(s.positions.col(c), q), q, {});
       EXPECT_GT(level, 0.92 * actual) << before << ", coordinate " << c;
       EXPECT_LT(level, 1.05 * actual) << before << ", coordinate " << c;
       EXPECT_GT(curve.noise_sigma()[c], 0.92 * actual) << before << ", coordinate " << c;
@@ -712,7 +714,9 @@ TEST(RoundedPositions, TheirNoiseGrowingWithTheSpeedIsNotTheStamps) {
   const Eigen::Index m = s.t.size();
   const internal::DifferenceMagnitudes magnitudes(s.t, s.positions, {});
   Eigen::VectorXd level(3);
-  for (Eigen::Index c = 0; c < 3; ++c) level[c] = internal::RoundingLevel(s.positions.col(c), q, {});
+  for (Eigen::Index c = 0; c < 3; ++c) {
+    level[c] = internal::RoundingLevel(internal::WholeSteps(s.positions.col(c), q), q, {});
+  }
   EXPECT_TRUE(internal::FindStampNoise(magnitudes).has_value());
   EXPECT_FALSE(internal::NoiseProfile(level, magnitudes, m, Eigen::Vector3d::Constant(q)).stamp_noise().has_value());
   const Curve curve = FitCurve(s.stamps, s.positions);
@@ -729,7 +733,8 @@ TEST(RoundedPositions, TailsAreNotTheNoiseBeforeTheRounding) {
   Eigen::MatrixXd rounded = Printed(s.positions, 3);
   for (Eigen::Index i = 100; i < rounded.rows(); i += 500) rounded.row(i).array() += 20e-3;
   for (Eigen::Index c = 0; c < 3; ++c) {
-    EXPECT_EQ(internal::RoundingLevel(rounded.col(c), 1e-3, {}), 1e-3 / std::sqrt(12.0)) << c;
+    const Eigen::VectorXd steps = internal::WholeSteps(rounded.col(c), 1e-3);
+    EXPECT_EQ(internal::RoundingLevel(steps, 1e-3, {}), 1e-3 / std::sqrt(12.0)) << c;
   }
 }
 
