@@ -370,12 +370,13 @@ bool IsRounded(const Eigen::Ref<const Eigen::VectorXd>& values, double q) {
 
 namespace cheval::cheb::internal {
 
-bool IsRoundedSteps(const Eigen::VectorXd& n) {
+bool IsRoundedSteps(const Eigen::VectorXd& steps) {
   Eigen::Index changing = 0, scattered = 0;
-  for (Eigen::Index i = 0; i + 4 < n.size(); ++i) {
-    if (n[i] == n[i + 1] && n[i] == n[i + 2] && n[i] == n[i + 3] && n[i] == n[i + 4]) continue;
+  for (Eigen::Index i = 0; i + 4 < steps.size(); ++i) {
+    const double first = steps[i];
+    if (first == steps[i + 1] && first == steps[i + 2] && first == steps[i + 3] && first == steps[i + 4]) continue;
     ++changing;
-    if (n[i] - 4.0 * n[i + 1] + 6.0 * n[i + 2] - 4.0 * n[i + 3] + n[i + 4] != 0.0) ++scattered;
+    if (steps[i] - 4.0 * steps[i + 1] + 6.0 * steps[i + 2] - 4.0 * steps[i + 3] + steps[i + 4] != 0.0) ++scattered;
   }
   return changing > 0 && static_cast<double>(scattered) >= kRoundedShare * static_cast<double>(changing);
 }
@@ -386,16 +387,16 @@ Eigen::VectorXd WholeSteps(const Eigen::Ref<const Eigen::VectorXd>& values, doub
   return n;
 }
 
-double RoundingLevel(const Eigen::VectorXd& n, double q, const std::vector<Eigen::Index>& breaks) {
+double RoundingLevel(const Eigen::VectorXd& steps, double q, const std::vector<Eigen::Index>& breaks) {
   const double floor = q / std::sqrt(12.0);
   // The 4th differences of the runs of five that no break crosses, in steps.
   std::vector<double> fourth;
-  fourth.reserve(static_cast<size_t>(n.size()));
+  fourth.reserve(static_cast<size_t>(steps.size()));
   size_t next = 0;  // the first break at or after the run's first sample
-  for (Eigen::Index i = 0; i + 4 < n.size(); ++i) {
+  for (Eigen::Index i = 0; i + 4 < steps.size(); ++i) {
     while (next < breaks.size() && breaks[next] < i) ++next;
     if (next < breaks.size() && breaks[next] < i + 4) continue;
-    fourth.push_back(std::abs(n[i] - 4.0 * n[i + 1] + 6.0 * n[i + 2] - 4.0 * n[i + 3] + n[i + 4]));
+    fourth.push_back(std::abs(steps[i] - 4.0 * steps[i + 1] + 6.0 * steps[i + 2] - 4.0 * steps[i + 3] + steps[i + 4]));
   }
   const auto runs = static_cast<double>(fourth.size());
   if (fourth.size() < static_cast<size_t>(kMinLevelRuns)) return floor;

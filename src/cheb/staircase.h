@@ -23,12 +23,11 @@ namespace cheval::cheb::internal {
 /// the rounded values err by q/sqrt(12) with errors correlated over a whole step.
 ///
 /// `t` ascending; `z` the values on the lattice of step q from FindResolution and `steps` the same
-/// in whole steps (WholeSteps(z, q)); `breaks` the boundaries b
-/// (between samples b and b + 1) no curve is drawn across (gaps). Only a clean staircase
-/// qualifies: at least 75 % of the differences zero (a step lasts four samples or more on
-/// average), nearly all others one step, and few of them undone by the next, very few within a
-/// few samples (noise at a step's edge flips the values back and forth, and the instants of those
-/// flips are the noise's).
+/// in whole steps (WholeSteps(z, q)); `breaks` the boundaries b (between samples b and b + 1) no
+/// curve is drawn across (gaps). Only a clean staircase qualifies: at least 75 % of the
+/// differences zero (a step lasts four samples or more on average), nearly all others one step,
+/// and few of them undone by the next, very few within a few samples (noise at a step's edge flips
+/// the values back and forth, and the instants of those flips are the noise's).
 std::optional<double> PlaceBetweenSteps(const Eigen::Ref<const Eigen::VectorXd>& t, Eigen::Ref<Eigen::VectorXd> z,
                                         const Eigen::VectorXd& steps, double q,
                                         const std::vector<Eigen::Index>& breaks);
