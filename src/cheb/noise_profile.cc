@@ -369,6 +369,14 @@ bool IsRounded(const Eigen::Ref<const Eigen::VectorXd>& values, double q) {
 }  // namespace cheval::cheb
 
 namespace cheval::cheb::internal {
+namespace {
+
+// The 4th difference of whole steps over samples i..i + 4 (exact: the steps are whole numbers).
+double FourthDifference(const Eigen::VectorXd& steps, Eigen::Index i) {
+  return steps[i] - 4.0 * steps[i + 1] + 6.0 * steps[i + 2] - 4.0 * steps[i + 3] + steps[i + 4];
+}
+
+}  // namespace
 
 bool IsRoundedSteps(const Eigen::VectorXd& steps) {
   Eigen::Index changing = 0, scattered = 0;
@@ -376,7 +384,7 @@ bool IsRoundedSteps(const Eigen::VectorXd& steps) {
     const double first = steps[i];
     if (first == steps[i + 1] && first == steps[i + 2] && first == steps[i + 3] && first == steps[i + 4]) continue;
     ++changing;
-    if (steps[i] - 4.0 * steps[i + 1] + 6.0 * steps[i + 2] - 4.0 * steps[i + 3] + steps[i + 4] != 0.0) ++scattered;
+    if (FourthDifference(steps, i) != 0.0) ++scattered;
   }
   return changing > 0 && static_cast<double>(scattered) >= kRoundedShare * static_cast<double>(changing);
 }
@@ -396,7 +404,7 @@ double RoundingLevel(const Eigen::VectorXd& steps, double q, const std::vector<E
   for (Eigen::Index i = 0; i + 4 < steps.size(); ++i) {
     while (next < breaks.size() && breaks[next] < i) ++next;
     if (next < breaks.size() && breaks[next] < i + 4) continue;
-    fourth.push_back(std::abs(steps[i] - 4.0 * steps[i + 1] + 6.0 * steps[i + 2] - 4.0 * steps[i + 3] + steps[i + 4]));
+    fourth.push_back(std::abs(FourthDifference(steps, i)));
   }
   const auto runs = static_cast<double>(fourth.size());
   if (fourth.size() < static_cast<size_t>(kMinLevelRuns)) return floor;
