@@ -29,6 +29,10 @@ constexpr Eigen::Index kBlock = 64;
 constexpr Eigen::Index kStepSamples = 8;
 // A step whose fit finds a jump of the rate this many standard errors away from none is a break.
 constexpr double kRateJumpScore = 3.0;
+// A break or step stays only where it explains the samples beside it better than a quintic by this
+// many variances (BreakBeatsSmoothMotion). Under noise alone the two fits' sums differ by about a
+// difference of two χ²(2)·σ², of standard deviation 2.8σ²: 9σ² is more than 3 of them.
+constexpr double kSmoothMargin = 9.0;
 // Passes over the slopes, each with the local scale taken again.
 constexpr int kPasses = 8;
 // The most consecutive samples an excursion (a burst of displaced samples, each displaced its own
@@ -306,6 +310,20 @@ class SlopeScan {
   const NoiseProfile* profile_ = nullptr;  // the profile block_floor_ comes from
 };
 
+// The samples beside boundary b that estimate it: up to kStepSamples on either side, not across a
+// cut, outliers left out (ascending).
+std::vector<Eigen::Index> SamplesBeside(Eigen::Index b, Eigen::Index m, const std::vector<char>& cut,
+                                        const std::vector<char>& left_out) {
+  Eigen::Index first = b, last = b + 1;
+  while (first > 0 && b - first + 1 < kStepSamples && !cut[static_cast<size_t>(first - 1)]) --first;
+  while (last + 1 < m && last - b < kStepSamples && !cut[static_cast<size_t>(last)]) ++last;
+  std::vector<Eigen::Index> used;
+  for (Eigen::Index i = first; i <= last; ++i) {
+    if (!left_out[static_cast<size_t>(i)]) used.push_back(i);
+  }
+  return used;
+}
+
 // Each step again, from the samples themselves: a cubic through kStepSamples samples on either
 // side plus the step, least squares, the other steps in reach taken out first (the slope-based
 // estimate carries its lines' prediction error). The same fit with a jump of the rate as well tells
@@ -322,16 +340,10 @@ void RefineSteps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::
   std::vector<char> rate_jumps(jumps.steps.size(), 0);
   for (size_t k = 0; k < jumps.steps.size(); ++k) {
     const Eigen::Index b = jumps.steps[k].first;
-    Eigen::Index first = b, last = b + 1;  // samples [first, last], not across a cut
-    while (first > 0 && b - first + 1 < kStepSamples && !cut[static_cast<size_t>(first - 1)]) --first;
-    while (last + 1 < m && last - b < kStepSamples && !cut[static_cast<size_t>(last)]) ++last;
-    std::vector<Eigen::Index> used;
-    for (Eigen::Index i = first; i <= last; ++i) {
-      if (!left_out[static_cast<size_t>(i)]) used.push_back(i);
-    }
+    const std::vector<Eigen::Index> used = SamplesBeside(b, m, cut, left_out);
     const auto rows = static_cast<Eigen::Index>(used.size());
     if (rows < 10) continue;
-    const double centre = 0.5 * (t[b] + t[b + 1]), half = 0.5 * (t[last] - t[first]);
+    const double centre = 0.5 * (t[b] + t[b + 1]), half = 0.5 * (t[used.back()] - t[used.front()]);
     Eigen::MatrixXd a(rows, 6);
     Eigen::MatrixXd y(rows, z.cols());
     for (Eigen::Index r = 0; r < rows; ++r) {
@@ -366,6 +378,41 @@ void RefineSteps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::
   }
   jumps.steps = std::move(steps);
   std::sort(jumps.breaks.begin(), jumps.breaks.end());
+}
+
+// Whether the samples beside boundary b (kStepSamples a side, not across a gap, outliers left out)
+// are told better by motion that breaks at b than by smooth motion of as many parameters: a cubic
+// with a jump of the value and of the rate against a quintic, least squares, per coordinate. The
+// break is kept when in some coordinate its residual sum of squares is below the quintic's by
+// kSmoothMargin variances of the samples about it (its residual variance, never below the noise's:
+// where neither fits, that is the misfit's). The slopes' lines judge departures against the noise;
+// where the noise is far below what lines through smooth motion can follow (the nearly exact
+// positions of a fast start or stop, whose rate's 3rd derivative jumps), smooth motion departs too
+// and was cut into pieces whose one-sided ends were 0.3 m/s off (docs/velocity.md, "Jumps and
+// glitches").
+bool BreakBeatsSmoothMotion(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::vector<char>& gap,
+                            const std::vector<char>& left_out, const SlopeScan& scan, Eigen::Index b) {
+  const std::vector<Eigen::Index> used = SamplesBeside(b, t.size(), gap, left_out);
+  const auto rows = static_cast<Eigen::Index>(used.size());
+  if (rows < 10) return true;  // too few to tell: the slopes' verdict stands
+  const double centre = 0.5 * (t[b] + t[b + 1]), half = 0.5 * (t[used.back()] - t[used.front()]);
+  Eigen::MatrixXd broken(rows, 6), smooth(rows, 6), y(rows, z.cols());
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    const Eigen::Index i = used[static_cast<size_t>(r)];
+    const double u = (t[i] - centre) / half, after = i > b ? 1.0 : 0.0;
+    broken.row(r) << 1.0, u, u * u, u * u * u, after, after * u;
+    smooth.row(r) << 1.0, u, u * u, u * u * u, u * u * u * u, u * u * u * u * u;
+    y.row(r) = z.row(i) - z.row(used[0]);  // about the first sample: positions far from the origin
+  }
+  const Eigen::MatrixXd broken_residual = y - broken * broken.colPivHouseholderQr().solve(y);
+  const Eigen::MatrixXd smooth_residual = y - smooth * smooth.colPivHouseholderQr().solve(y);
+  for (Eigen::Index c = 0; c < z.cols(); ++c) {
+    const double with_break = broken_residual.col(c).squaredNorm();
+    const double variance =
+        std::max(with_break / static_cast<double>(rows - 6), scan.SampleNoise(c) * scan.SampleNoise(c));
+    if (smooth_residual.col(c).squaredNorm() - with_break > kSmoothMargin * variance) return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -461,6 +508,13 @@ Jumps FindJumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
     }
     if (!changed) break;
   }
+  // Breaks and steps that smooth motion explains as well are not defects (BreakBeatsSmoothMotion).
+  std::vector<char> gap(static_cast<size_t>(t.size()), 0);
+  for (const Eigen::Index b : gaps) gap[static_cast<size_t>(b)] = 1;
+  auto smooth = [&](Eigen::Index b) { return !BreakBeatsSmoothMotion(t, z, gap, left_out, scan, b); };
+  jumps.breaks.erase(std::remove_if(jumps.breaks.begin(), jumps.breaks.end(), smooth), jumps.breaks.end());
+  jumps.steps.erase(std::remove_if(jumps.steps.begin(), jumps.steps.end(), [&](const auto& step) { return smooth(step.first); }),
+                    jumps.steps.end());
   std::sort(jumps.outliers.begin(), jumps.outliers.end());
   jumps.outliers.erase(std::unique(jumps.outliers.begin(), jumps.outliers.end()), jumps.outliers.end());
   std::sort(jumps.breaks.begin(), jumps.breaks.end());
