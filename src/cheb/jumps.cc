@@ -29,7 +29,7 @@ constexpr Eigen::Index kBlock = 64;
 // nearer side's line (min(|d_j − left|, |d_j − right|)): 1.50 times the two-sided departure's
 // median under white noise (measured, 12 % scatter between blocks of 64), with a margin of 2, so
 // that noise leaves the two-sided scale alone. Every slope within kSide of a jump of the rate
-// departs from the lines across it; where jumps are closer than twice that (a bouncing ball, a
+// departs from the lines across it; where jumps come every few dozen slopes (a bouncing ball, a
 // gait's impacts), their neighbours are the block's median and hid all but the largest, while a
 // slope's nearer side is clean.
 constexpr double kNearerSide = 3.0;
@@ -167,7 +167,8 @@ class SlopeScan {
     if (!PredictFrom(j, -1, &left) || !PredictFrom(j, 1, &right)) return std::nullopt;
     if (disagreement != nullptr) *disagreement = right - left;
     if (one_sided != nullptr) {
-      *one_sided = (slopes_.row(j).transpose() - left).cwiseAbs().cwiseMin((slopes_.row(j).transpose() - right).cwiseAbs());
+      const Point slope = slopes_.row(j).transpose();
+      *one_sided = (slope - left).cwiseAbs().cwiseMin((slope - right).cwiseAbs());
     }
     return Point(slopes_.row(j).transpose() - 0.5 * (left + right));
   }
@@ -541,7 +542,8 @@ Jumps FindJumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::v
   for (const Eigen::Index b : gaps) gap[static_cast<size_t>(b)] = 1;
   auto smooth = [&](Eigen::Index b) { return !BreakBeatsSmoothMotion(t, z, gap, left_out, scan, b); };
   jumps.breaks.erase(std::remove_if(jumps.breaks.begin(), jumps.breaks.end(), smooth), jumps.breaks.end());
-  jumps.steps.erase(std::remove_if(jumps.steps.begin(), jumps.steps.end(), [&](const auto& step) { return smooth(step.first); }),
+  jumps.steps.erase(std::remove_if(jumps.steps.begin(), jumps.steps.end(),
+                                   [&](const auto& step) { return smooth(step.first); }),
                     jumps.steps.end());
   std::sort(jumps.outliers.begin(), jumps.outliers.end());
   jumps.outliers.erase(std::unique(jumps.outliers.begin(), jumps.outliers.end()), jumps.outliers.end());
