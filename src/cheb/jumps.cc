@@ -352,6 +352,27 @@ std::vector<Eigen::Index> SamplesBeside(Eigen::Index b, Eigen::Index m, const st
   return used;
 }
 
+// The cubic with a jump of the value and of the rate at boundary b, as a design matrix over the
+// samples `used` (SamplesBeside): columns 1, u, u², u³, [i > b], [i > b]·u, with u the time from
+// the boundary's middle over half the samples' span.
+Eigen::MatrixXd BrokenCubic(const Eigen::VectorXd& t, const std::vector<Eigen::Index>& used, Eigen::Index b) {
+  const double centre = 0.5 * (t[b] + t[b + 1]), half = 0.5 * (t[used.back()] - t[used.front()]);
+  Eigen::MatrixXd a(static_cast<Eigen::Index>(used.size()), 6);
+  for (Eigen::Index r = 0; r < a.rows(); ++r) {
+    const Eigen::Index i = used[static_cast<size_t>(r)];
+    const double u = (t[i] - centre) / half, after = i > b ? 1.0 : 0.0;
+    a.row(r) << 1.0, u, u * u, u * u * u, after, after * u;
+  }
+  return a;
+}
+
+// The residual variance of a 6-parameter fit to `rows` samples with residual sum of squares
+// `rss`, never below the samples' noise variance in coordinate c: a noise-free fit's rounding is
+// not evidence.
+double FlooredVariance(double rss, Eigen::Index rows, const SlopeScan& scan, Eigen::Index c) {
+  return std::max(rss / static_cast<double>(rows - 6), scan.SampleNoise(c) * scan.SampleNoise(c));
+}
+
 // Each step again, from the samples themselves: a cubic through kStepSamples samples on either
 // side plus the step, least squares, the other steps in reach taken out first (the slope-based
 // estimate carries its lines' prediction error). The same fit with a jump of the rate as well tells
@@ -371,13 +392,10 @@ void RefineSteps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::
     const std::vector<Eigen::Index> used = SamplesBeside(b, m, cut, left_out);
     const auto rows = static_cast<Eigen::Index>(used.size());
     if (rows < 10) continue;
-    const double centre = 0.5 * (t[b] + t[b + 1]), half = 0.5 * (t[used.back()] - t[used.front()]);
-    Eigen::MatrixXd a(rows, 6);
+    const Eigen::MatrixXd a = BrokenCubic(t, used, b);
     Eigen::MatrixXd y(rows, z.cols());
     for (Eigen::Index r = 0; r < rows; ++r) {
       const Eigen::Index i = used[static_cast<size_t>(r)];
-      const double u = (t[i] - centre) / half, after = i > b ? 1.0 : 0.0;
-      a.row(r) << 1.0, u, u * u, u * u * u, after, after * u;
       y.row(r) = z.row(i);
       for (size_t o = 0; o < jumps.steps.size(); ++o) {  // the other steps between this one and sample i
         const Eigen::Index s = jumps.steps[o].first;
@@ -390,8 +408,7 @@ void RefineSteps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const std::
     const Eigen::MatrixXd full = with_rate.solve(y);
     const Eigen::MatrixXd inverse = (a.transpose() * a).inverse();
     for (Eigen::Index c = 0; c < z.cols(); ++c) {
-      const double variance = std::max((y.col(c) - a * full.col(c)).squaredNorm() / static_cast<double>(rows - 6),
-                                       scan.SampleNoise(c) * scan.SampleNoise(c));
+      const double variance = FlooredVariance((y.col(c) - a * full.col(c)).squaredNorm(), rows, scan, c);
       if (std::abs(full(5, c)) > kRateJumpScore * std::sqrt(variance * inverse(5, 5))) rate_jumps[k] = 1;
     }
     jumps.steps[k].second = a.leftCols(5).colPivHouseholderQr().solve(y).row(4).transpose();
@@ -423,22 +440,20 @@ bool BreakBeatsSmoothMotion(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, 
   const std::vector<Eigen::Index> used = SamplesBeside(b, t.size(), gap, left_out);
   const auto rows = static_cast<Eigen::Index>(used.size());
   if (rows < 10) return true;  // too few to tell: the slopes' verdict stands
-  const double centre = 0.5 * (t[b] + t[b + 1]), half = 0.5 * (t[used.back()] - t[used.front()]);
-  Eigen::MatrixXd broken(rows, 6), smooth(rows, 6), y(rows, z.cols());
+  const Eigen::MatrixXd broken = BrokenCubic(t, used, b);
+  Eigen::MatrixXd smooth(rows, 6), y(rows, z.cols());
   for (Eigen::Index r = 0; r < rows; ++r) {
-    const Eigen::Index i = used[static_cast<size_t>(r)];
-    const double u = (t[i] - centre) / half, after = i > b ? 1.0 : 0.0;
-    broken.row(r) << 1.0, u, u * u, u * u * u, after, after * u;
+    const double u = broken(r, 1);
     smooth.row(r) << 1.0, u, u * u, u * u * u, u * u * u * u, u * u * u * u * u;
-    y.row(r) = z.row(i) - z.row(used[0]);  // about the first sample: positions far from the origin
+    // About the first sample: positions may lie far from the origin.
+    y.row(r) = z.row(used[static_cast<size_t>(r)]) - z.row(used[0]);
   }
   const Eigen::MatrixXd broken_residual = y - broken * broken.colPivHouseholderQr().solve(y);
   const Eigen::MatrixXd smooth_residual = y - smooth * smooth.colPivHouseholderQr().solve(y);
   for (Eigen::Index c = 0; c < z.cols(); ++c) {
     const double with_break = broken_residual.col(c).squaredNorm();
-    const double variance =
-        std::max(with_break / static_cast<double>(rows - 6), scan.SampleNoise(c) * scan.SampleNoise(c));
-    if (smooth_residual.col(c).squaredNorm() - with_break > kSmoothMargin * variance) return true;
+    const double margin = kSmoothMargin * FlooredVariance(with_break, rows, scan, c);
+    if (smooth_residual.col(c).squaredNorm() - with_break > margin) return true;
   }
   return false;
 }
