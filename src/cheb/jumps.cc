@@ -11,6 +11,7 @@
 #include <Eigen/QR>
 
 #include "noise_profile.h"
+#include "residual_test.h"
 
 namespace cheval::cheb::internal {
 namespace {
@@ -73,12 +74,11 @@ class SlopeScan {
     for (const Eigen::Index b : gaps) {
       if (b >= 0 && b < n_) cut_[static_cast<size_t>(b)] = 1;
     }
-    // Floor of the local scale: the slope noise of white position noise σ (sqrt(2)·σ/dt), and a
-    // rounding level so that exact data do not make every departure infinite.
+    // Floor of the local scale: the slope noise of white position noise σ (sqrt(2)·σ/dt), and the
+    // values' rounding level (RoundingFloor) so that exact data do not make every departure infinite.
     noise_floor_ = Eigen::VectorXd(d_);
     for (Eigen::Index c = 0; c < d_; ++c) {
-      const double magnitude = n_ >= 0 ? z.col(c).cwiseAbs().maxCoeff() : 0.0;
-      noise_floor_[c] = std::max(std::sqrt(2.0) * noise[c], 1e-9 * (1.0 + magnitude));
+      noise_floor_[c] = std::max(std::sqrt(2.0) * noise[c], RoundingFloor(z.col(c)));
     }
     // Where the noise profile is raised (over a burst, the blocks beside it too) or follows stamp
     // noise, its slope noise floors the scale instead.

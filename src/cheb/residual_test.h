@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Core>
 
@@ -22,16 +23,27 @@ using cheb::kLackOfFitLimit;
 // rate 2–3x worse); a residual of 1.5σ (a missed tremor) still fails.
 inline constexpr double kNoiseMargin = 1.1;
 
+// The rounding level of one coordinate's values `z`: 1e-9 of their range, at least 1e-9 (values
+// written to nanometres), and a few units in the last place of the largest (the doubles' own
+// spacing). Not of their magnitude: positions far from the origin (UTM northings, 5e6 m) raised it
+// to millimetres, which blinded the residual test and the jump search there (EuRoC MH_05 moved to
+// UTM coordinates: 1.20 -> 1.48 mm/s against its own velocity).
+inline double RoundingFloor(const Eigen::Ref<const Eigen::VectorXd>& z) {
+  if (z.size() == 0) return 1e-9;
+  const double range = z.maxCoeff() - z.minCoeff();
+  return 1e-9 * (1.0 + range) + 4.0 * std::numeric_limits<double>::epsilon() * z.cwiseAbs().maxCoeff();
+}
+
 // The noise σ per coordinate a window's samples `z` are tested against: the noise profile's over
-// them (`level`), floored at a rounding level of the values (1e-9 of their magnitude) so that
-// exact data do not ask for an exact fit. Not the window's own estimate: a short window's
+// them (`level`), floored at the values' rounding level (RoundingFloor) so that exact data do not
+// ask for an exact fit. Not the window's own estimate: a short window's
 // scatters by tens of per cent, and taking the larger would let small unresolved motion pass as
 // noise; the profile pools 160 samples and departs from the data's level only by a factor that
 // scatter does not reach (NoiseProfile).
 inline Eigen::VectorXd WindowSigma(const Eigen::VectorXd& level, const Eigen::Ref<const Eigen::MatrixXd>& z) {
   Eigen::VectorXd sigma(z.cols());
   for (Eigen::Index c = 0; c < z.cols(); ++c) {
-    sigma[c] = std::max(level[c], 1e-9 * (1.0 + z.col(c).cwiseAbs().maxCoeff()));
+    sigma[c] = std::max(level[c], RoundingFloor(z.col(c)));
   }
   return sigma;
 }
