@@ -39,6 +39,7 @@ constexpr std::array<int, 11> kCapBoundaries{4, 6, 8, 11, 16, 23, 32, 45, 64, 91
 // that starts mid-move and then rests gave 50–370 for the low-degree caps its rests chose. Such a
 // candidate is refused only where it also fits the real end's samples worse than the end window
 // (CapMisfit): at TUM-VI's segment ends, next to noise bursts, the end window's rate is what is off.
+// In a short segment the misfit alone refuses a candidate (ChooseCap).
 constexpr double kEndLikeness = 5.0;
 // Artificial ends per direction (pooled: 2 x 32 one-sided fits per candidate and end; 64 gave the
 // same errors on the benchmark within ±0.2 % in geometric mean, at twice the cost).
@@ -275,9 +276,7 @@ Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloc
       degrees.push_back(p);
     }
     const Eigen::ArrayXXd misfit =
-        end_variance == nullptr
-            ? CapMisfit(t, z, front ? segment_first : segment_last - m, m, front, degrees, end, end_samples)
-            : Eigen::ArrayXXd::Zero(static_cast<Eigen::Index>(degrees.size()), d);
+        CapMisfit(t, z, front ? segment_first : segment_last - m, m, front, degrees, end, end_samples);
     for (size_t k = 0; k < degrees.size(); ++k) {
       const Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(offsets, d);
       candidates.push_back({m, degrees[k], offsets, zero, zero, misfit.row(static_cast<Eigen::Index>(k)).transpose()});
@@ -361,14 +360,18 @@ Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloc
         // whose cancellation left the rate 3,000 m/s off on a 0.5 m/s sine).
         double lowest = m <= end_samples ? 0.0 : std::numeric_limits<double>::infinity();
         for (size_t k = i; k < j; ++k) {
-          // The artificial ends speak for the real end only where it is like them: a candidate
-          // that changes the rate there kEndLikeness times more than at them (root mean square,
-          // blended) and fits the samples there clearly worse than the end window does
-          // (CapMisfit) is not taken in this coordinate.
-          if (!real.empty()) {
-            const double typical = w.cwiseAbs2().dot(candidates[k].a.col(c).head(n)) / pooled;
-            const double here = w.cwiseAbs2().dot(real[k].a.col(c).head(n));
-            if (here > kEndLikeness * kEndLikeness * typical && candidates[k].misfit[c] > kLackOfFitLimit) continue;
+          // A candidate that fits the real end's own samples clearly worse than the end window
+          // (CapMisfit) is not taken in this coordinate where the artificial ends cannot vouch for
+          // it: in a short segment, whose artificial ends measure it against the end window's own
+          // rate, or where it changes the rate at the real end kEndLikeness times more than at them
+          // (root mean square, blended).
+          if (candidates[k].misfit[c] > kLackOfFitLimit) {
+            if (end_variance != nullptr) continue;
+            if (!real.empty()) {
+              const double typical = w.cwiseAbs2().dot(candidates[k].a.col(c).head(n)) / pooled;
+              const double here = w.cwiseAbs2().dot(real[k].a.col(c).head(n));
+              if (here > kEndLikeness * kEndLikeness * typical) continue;
+            }
           }
           const double gain = gain_of(k, c);
           if (gain < lowest) lowest = gain, choice.degrees[c] = candidates[k].degree;

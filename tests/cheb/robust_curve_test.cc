@@ -336,6 +336,27 @@ TEST(EndCaps, ASegmentThatStartsMidMoveKeepsTheMove) {
   EXPECT_LT(VelocityRmse(curve, s), 0.3 * CentralRmse(s));
 }
 
+// A recording that rests for 4.5 s and ends 1 s into a slow move (a 3.7 m leg over 7.5 s) under
+// 0.1 mm: a segment of one or two windows, whose artificial ends lie inside its end window, at rest.
+// They chose a linear cap over 128 samples for its end, which kept the rate there near zero
+// while the move reached 0.12 m/s: 8.0–10.6 mm/s on three of these four draws, against central
+// differences' 12.4–12.8. Such a cap fits the samples at the end clearly worse than the end window
+// and is no longer taken (CapMisfit).
+TEST(EndCaps, ARecordingThatEndsAsAMoveStartsKeepsTheMove) {
+  const Eigen::Vector3d leg = Eigen::Vector3d(0.848, -0.394, 0.354) * 3.735;
+  auto start = [&](double t, Eigen::Vector3d* p, Eigen::Vector3d* v) {
+    const double a = 4.5, b = a + 7.47, u = std::clamp((t - a) / (b - a), 0.0, 1.0);
+    *p = (u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)) * leg;
+    *v = (30.0 * u * u * (1.0 - u) * (1.0 - u) / (b - a)) * leg;
+  };
+  for (const uint64_t seed : {1, 2, 3, 4}) {
+    const Motion s = Sample(start, 5.5, 100.0, 1e-4, 0.3e-3, seed);
+    const Curve curve = FitCurve(s.stamps, s.positions);
+    EXPECT_EQ(SamplesOff(curve, s, 0.05), 0) << "seed " << seed << ": samples with a velocity error above 50 mm/s";
+    EXPECT_LT(VelocityRmse(curve, s), 0.3 * CentralRmse(s)) << "seed " << seed;
+  }
+}
+
 // A single displaced sample (a glitch) is left out: it bends nothing.
 TEST(Jumps, AGlitchIsLeftOut) {
   Motion s = Sample(Smooth, 10.0, 200.0, 0.0, 0.0, 5);
