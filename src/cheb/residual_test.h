@@ -36,10 +36,10 @@ inline double RoundingFloor(const Eigen::Ref<const Eigen::VectorXd>& z) {
 
 // The noise σ per coordinate a window's samples `z` are tested against: the noise profile's over
 // them (`level`), floored at the values' rounding level (RoundingFloor) so that exact data do not
-// ask for an exact fit. Not the window's own estimate: a short window's
-// scatters by tens of per cent, and taking the larger would let small unresolved motion pass as
-// noise; the profile pools 160 samples and departs from the data's level only by a factor that
-// scatter does not reach (NoiseProfile).
+// ask for an exact fit. Not the window's own estimate: a short window's scatters by tens of per
+// cent, and taking the larger would let small unresolved motion pass as noise; the profile pools
+// 160 samples and departs from the data's level only by a factor that scatter does not reach
+// (NoiseProfile).
 inline Eigen::VectorXd WindowSigma(const Eigen::VectorXd& level, const Eigen::Ref<const Eigen::MatrixXd>& z) {
   Eigen::VectorXd sigma(z.cols());
   for (Eigen::Index c = 0; c < z.cols(); ++c) {
