@@ -216,18 +216,12 @@ Eigen::ArrayXXd CapMisfit(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, Ei
   try {
     const NormalEquations normal = BuildNormalEquations(t.segment(begin, m), values, top, interval);
     const NestedCholesky cholesky(normal, top);
-    Eigen::MatrixXd basis(n, top + 1);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double x = interval.ToUnit(t[begin + near + i]);
-      basis(i, 0) = 1.0;
-      if (top >= 1) basis(i, 1) = x;
-      for (int k = 2; k <= top; ++k) basis(i, k) = 2.0 * x * basis(i, k - 1) - basis(i, k - 2);
-    }
+    Eigen::VectorXd x(n);
+    for (Eigen::Index i = 0; i < n; ++i) x[i] = interval.ToUnit(t[begin + near + i]);
     const auto share = static_cast<double>(n);
     for (size_t k = 0; k < degrees.size(); ++k) {
       const int p = degrees[k];
-      const Eigen::MatrixXd residual =
-          values.middleRows(near, n) - basis.leftCols(p + 1) * cholesky.Solve(p, normal.rhs);
+      const Eigen::MatrixXd residual = values.middleRows(near, n) - EvaluateSeries(cholesky.Solve(p, normal.rhs), x);
       const double cap_dof = share * (1.0 - (p + 1.0) / static_cast<double>(m));
       for (Eigen::Index c = 0; c < d; ++c) {
         const double end_dof = share * (1.0 - (end.degrees[c] + 1.0) / static_cast<double>(end_samples));
