@@ -196,7 +196,14 @@ std::optional<GapFit> FitGap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z,
   const Eigen::Index last = std::upper_bound(data + gap, data + after, t[gap] + reach) - data;
   fit.count = last - fit.first;
   const Eigen::Index left = gap - fit.first, right = last - gap;
-  if (std::min(left, right) < kMinSide) return std::nullopt;
+  // A side with fewer samples is taken only where no reach gives it more (its run's end, a
+  // recording's first or last samples after a dropout) and its samples give a rate to test the
+  // fit's against (SideHelps: at least two).
+  const bool left_ends = fit.first == before, right_ends = last == after;
+  const bool short_side_ends =
+      ((left < kMinSide && left >= 2 && left_ends && right >= kMinSide) ||
+       (right < kMinSide && right >= 2 && right_ends && left >= kMinSide));
+  if (std::min(left, right) < kMinSide && !short_side_ends) return std::nullopt;
   const Interval interval{t[fit.first], t[last - 1]};
   double length = 0.0;  // the longest hole inside
   for (Eigen::Index i = fit.first + 1; i < last; ++i) length = std::max(length, t[i] - t[i - 1]);
