@@ -445,20 +445,24 @@ void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloci
     return std::upper_bound(begin, end, b) - std::lower_bound(begin, end, a);
   };
   // Artificial ends lie where the curve's velocity is an interior one: off both end windows. In a
-  // segment of one or two windows, there is no such place: each end's artificial ends lie in the
-  // middle half of its end window's samples, where that window's rate varies least, and its rate is
-  // the reference there.
-  const bool spanned = windows.size() <= 2;
+  // segment of one or two windows there is no such place, and in a longer one whose end windows
+  // overlap there may be too little of it for one-sided fits as long as the end window: then each
+  // end's artificial ends lie in the middle half of its end window's samples, where that window's
+  // rate varies least, and its rate is the reference there ("spanned").
   const ArtificialEnds interior{std::upper_bound(begin, end, windows.front().fit_end) - t.data(),
                                 std::lower_bound(begin, end, windows.back().fit_begin) - t.data(), 0, 0};
-  if (!spanned && interior.hi <= interior.lo) return;
-  // The end windows' factors: one when the segment is one window, whose two ends share it.
-  std::array<std::optional<NestedCholesky>, 2> factors;
-  if (spanned) {
-    ParallelFor(static_cast<int>(windows.size()), threads, [&](int k) {
-      factors[static_cast<size_t>(k)] = FactorWindow(t, z, k == 0 ? windows.front() : windows.back());
-    });
+  const Eigen::Index room = std::max<Eigen::Index>(interior.hi - interior.lo, 0);
+  std::array<bool, 2> spanned{};
+  for (const size_t side : {0, 1}) {
+    const CurveWindow& w = side == 0 ? windows.front() : windows.back();
+    spanned[side] = windows.size() <= 2 || (short_segments && room < samples_in(w.fit_begin, w.fit_end));
   }
+  // The spanned ends' factors: one when the segment is one window, whose two ends share it.
+  std::array<std::optional<NestedCholesky>, 2> factors;
+  ParallelFor(windows.size() == 1 ? 1 : 2, threads, [&](int k) {
+    const auto side = static_cast<size_t>(k);
+    if (spanned[side]) factors[side] = FactorWindow(t, z, side == 0 ? windows.front() : windows.back());
+  });
   std::array<Choice, 2> choices;
   ParallelFor(2, threads, [&](int side) {
     const bool front = side == 0;
@@ -466,7 +470,8 @@ void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloci
     const Eigen::Index end_samples = samples_in(w.fit_begin, w.fit_end);
     const Eigen::Index core_samples = samples_in(w.core_begin, w.core_end);
     const int shortest = (front ? front_at_jump : segment->continues) ? kLongCap : 0;
-    if (!spanned) {
+    if (!spanned[static_cast<size_t>(side)]) {
+      if (room == 0) return;
       choices[static_cast<size_t>(side)] = ChooseCap(t, z, velocity, {interior.lo, interior.hi, interior.lo, interior.hi},
                                                      last - first, w, end_samples, core_samples, shortest, nullptr,
                                                      front, first, last);
