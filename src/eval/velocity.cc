@@ -359,7 +359,9 @@ std::string UnresolvedWarning(const cheb::Curve& curve) {
   // largest value bounded by the window's series (|T_k| ≤ 1).
   auto reproduces_its_samples = [&](const cheb::CurveWindow& w) {
     const Eigen::MatrixXd& a = w.series.coefficients;
-    if (a.rows() == 0 || a.cols() != w.residual_rms.size()) return false;
+    if (a.rows() == 0 || a.cols() != w.residual_rms.size() || static_cast<Eigen::Index>(w.degrees.size()) != a.cols()) {
+      return false;
+    }
     for (Eigen::Index c = 0; c < a.cols(); ++c) {
       const double varying = a.col(c).tail(a.rows() - 1).cwiseAbs().sum();
       const double floor = kExactResidual * (1.0 + 2.0 * varying) +
