@@ -162,6 +162,9 @@ struct Choice {
   double gain = 0;  // pooled change of the summed squared velocity error (< 0: the cap helps)
   int samples = 0, boundary = 0;
   std::vector<int> degrees;  // per coordinate; -1 keeps the end window's polynomial
+  // False where the artificial ends had too little room to judge the candidates (too short for
+  // their one-sided fits, or fewer than 8 of them): no cap was chosen for want of a judgement.
+  bool judged = true;
 };
 
 // Where the artificial ends of a segment lie: the velocities are compared at samples [lo, hi), where
@@ -255,15 +258,25 @@ Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloc
            (end_variance == nullptr || BlendEnd(boundary) <= end_variance->rows());
   };
   std::vector<Candidate> candidates;
+  Choice unjudged;
+  unjudged.judged = false;
+  bool cramped = false;  // a candidate left out for the artificial ends' room
   Eigen::Index block_samples = end_variance == nullptr ? end_samples : 0, end_offsets = 0;
   for (const int m : kCapSamples) {
     if (m < shortest) continue;
-    if (m > block_room || 2 * m > segment_samples) break;
+    if (m > block_room || 2 * m > segment_samples) {
+      cramped = cramped || m > block_room;
+      break;
+    }
     Eigen::Index offsets = 0;
     for (const int boundary : kCapBoundaries) {
       if (boundary_allowed(m, boundary)) offsets = BlendEnd(boundary);
     }
-    if (offsets == 0 || offsets > room) continue;
+    if (offsets == 0) continue;
+    if (offsets > room) {
+      cramped = true;
+      continue;
+    }
     std::vector<int> degrees;
     for (const int p : kCapDegrees) {
       if (m >= kLongCap ? 4 * (p + 1) > m : p + 3 > m) break;
@@ -278,7 +291,8 @@ Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloc
     block_samples = std::max<Eigen::Index>(block_samples, m);
     end_offsets = std::max(end_offsets, offsets);
   }
-  if (candidates.empty() || block_samples > block_room || end_offsets > room) return {};
+  if (candidates.empty()) return cramped ? unjudged : Choice{};
+  if (block_samples > block_room || end_offsets > room) return unjudged;
   if (end_variance == nullptr && end_offsets > end_samples) return {};
 
   const int end_top = *std::max_element(end.degrees.begin(), end.degrees.end());
@@ -306,7 +320,7 @@ Choice ChooseCap(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloc
       }
     }
   }
-  if (pooled < 8) return {};  // too few artificial ends for pooled errors to be trusted
+  if (pooled < 8) return unjudged;  // too few artificial ends for pooled errors to be trusted
 
   // Each candidate's change of the rate at the real end, against the curve's own rate there (a
   // only: Σ Δ² per offset and coordinate), for the test below. Not in a short segment: there the
@@ -446,23 +460,20 @@ void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloci
   };
   // Artificial ends lie where the curve's velocity is an interior one: off both end windows. In a
   // segment of one or two windows there is no such place, and in a longer one whose end windows
-  // overlap there may be too little of it for one-sided fits as long as the end window: then each
-  // end's artificial ends lie in the middle half of its end window's samples, where that window's
-  // rate varies least, and its rate is the reference there ("spanned").
+  // overlap there may be too little of it to judge the candidates (ChooseCap's Choice::judged):
+  // then each end's artificial ends lie in the middle half of its end window's samples, where that
+  // window's rate varies least, and its rate is the reference there ("spanned").
+  const bool spanned = windows.size() <= 2;
   const ArtificialEnds interior{std::upper_bound(begin, end, windows.front().fit_end) - t.data(),
                                 std::lower_bound(begin, end, windows.back().fit_begin) - t.data(), 0, 0};
-  const Eigen::Index room = std::max<Eigen::Index>(interior.hi - interior.lo, 0);
-  std::array<bool, 2> spanned{};
-  for (const size_t side : {0, 1}) {
-    const CurveWindow& w = side == 0 ? windows.front() : windows.back();
-    spanned[side] = windows.size() <= 2 || (short_segments && room < samples_in(w.fit_begin, w.fit_end));
-  }
-  // The spanned ends' factors: one when the segment is one window, whose two ends share it.
+  if (!spanned && interior.hi <= interior.lo && !short_segments) return;
+  // The end windows' factors: one when the segment is one window, whose two ends share it.
   std::array<std::optional<NestedCholesky>, 2> factors;
-  ParallelFor(windows.size() == 1 ? 1 : 2, threads, [&](int k) {
-    const auto side = static_cast<size_t>(k);
-    if (spanned[side]) factors[side] = FactorWindow(t, z, side == 0 ? windows.front() : windows.back());
-  });
+  if (spanned) {
+    ParallelFor(static_cast<int>(windows.size()), threads, [&](int k) {
+      factors[static_cast<size_t>(k)] = FactorWindow(t, z, k == 0 ? windows.front() : windows.back());
+    });
+  }
   std::array<Choice, 2> choices;
   ParallelFor(2, threads, [&](int side) {
     const bool front = side == 0;
@@ -470,16 +481,21 @@ void AddEndCaps(const Eigen::VectorXd& t, const Eigen::MatrixXd& z, const Veloci
     const Eigen::Index end_samples = samples_in(w.fit_begin, w.fit_end);
     const Eigen::Index core_samples = samples_in(w.core_begin, w.core_end);
     const int shortest = (front ? front_at_jump : segment->continues) ? kLongCap : 0;
-    if (!spanned[static_cast<size_t>(side)]) {
-      if (room == 0) return;
-      choices[static_cast<size_t>(side)] = ChooseCap(t, z, velocity, {interior.lo, interior.hi, interior.lo, interior.hi},
-                                                     last - first, w, end_samples, core_samples, shortest, nullptr,
-                                                     front, first, last);
-      return;
+    std::optional<NestedCholesky> own_factor;
+    if (!spanned) {
+      if (interior.hi > interior.lo) {
+        choices[static_cast<size_t>(side)] =
+            ChooseCap(t, z, velocity, {interior.lo, interior.hi, interior.lo, interior.hi}, last - first, w,
+                      end_samples, core_samples, shortest, nullptr, front, first, last);
+        if (choices[static_cast<size_t>(side)].judged) return;
+      }
+      if (!short_segments) return;
+      own_factor = FactorWindow(t, z, w);
     }
     // The end window's rate at the real end's samples, and its variance there.
     const Eigen::Index offsets = std::min(end_samples / 2, BlendEnd(kCapBoundaries.back()));
-    const std::optional<NestedCholesky>& factor = factors[windows.size() == 1 ? 0 : static_cast<size_t>(side)];
+    const std::optional<NestedCholesky>& factor =
+        spanned ? factors[windows.size() == 1 ? 0 : static_cast<size_t>(side)] : own_factor;
     if (!factor) return;  // its samples no longer determine the window (repeated stamps)
     const std::optional<Eigen::MatrixXd> end_variance =
         RateVariance(t, w, *factor, front ? first : last - 1, front ? 1 : -1, offsets);

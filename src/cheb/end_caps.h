@@ -27,8 +27,9 @@ using VelocityAt = std::function<Eigen::MatrixXd(Eigen::Index first, Eigen::Inde
 /// window's own polynomial inside the cap. A cap is added only when it lowers the pooled error.
 ///
 /// A segment of one or two windows has no interior off its end windows, and one whose end windows
-/// overlap may leave fewer samples there than an end window holds. With `short_segments`, such an
-/// end's artificial ends then lie in the middle half of its end window's samples, where that
+/// overlap may leave too little there to judge the candidates (room for fewer than 8 one-sided fits
+/// of their length). With `short_segments`, such an end's artificial ends then lie in the middle
+/// half of its end window's samples, where that
 /// window's rate is the reference (its variance there is a fraction of the end's); the window's own
 /// error at the real end, which no artificial end reproduces, is taken as its rate's variance there
 /// (σ²·dᵀG⁻¹d with the window's σ, without a bias), and a cap is added where the blend of the two

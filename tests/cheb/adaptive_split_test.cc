@@ -23,7 +23,7 @@ struct Case {
 // The simulator's motion of `kind` and `seed` (by default the kind's duration and rate) with noise
 // σ, and its exact velocity at the stamps.
 Case Simulated(sim::MotionKind kind, uint64_t seed, double noise_m, std::optional<double> duration_s = std::nullopt,
-               std::optional<double> rate_hz = std::nullopt) {
+               std::optional<double> rate_hz = std::nullopt, int gap_count = 0, double gap_s = 0.0) {
   sim::MotionOptions options;
   options.kind = kind;
   options.seed = seed;
@@ -32,6 +32,8 @@ Case Simulated(sim::MotionKind kind, uint64_t seed, double noise_m, std::optiona
   const sim::MotionModel model(options);
   sim::MeasurementOptions measurement;
   measurement.noise_m = noise_m;
+  measurement.gap_count = gap_count;
+  measurement.gap_s = gap_s;
   const traj::Trajectory measured = sim::Measure(model, measurement);
   const traj::Trajectory truth = sim::SampleMotion(model, measured.stamps_ns());
   return {{measured.stamps_ns().begin(), measured.stamps_ns().end()}, measured.positions().transpose(),
@@ -186,6 +188,16 @@ TEST(EndCaps, AClipWithLittleRoomBetweenItsEndWindowsIsCapped) {
   }
   const double rmse = std::sqrt(sum / 8);
   EXPECT_LT(rmse, 0.0284) << "m/s; the best Savitzky-Golay window's is 0.0284";
+}
+
+// Between dropouts a segment of several windows can leave room between its end windows for a few
+// one-sided fits as long as an end window, but fewer than the 8 artificial ends a judgement pools:
+// such ends had no caps. They are now judged inside their own end window, as a short segment's.
+// The legged motion at 50 Hz under 0.5 mm with 5 dropouts of 0.3 s in 20 s (seed 3): 10.69 mm/s,
+// now 9.18 (the best Savitzky–Golay window: 19.3).
+TEST(EndCaps, EndsWithTooFewArtificialEndsBetweenThemAreCapped) {
+  const Case c = Simulated(sim::MotionKind::kLegged, 3, 0.5e-3, 20.0, 50.0, 5, 0.3);
+  EXPECT_LT(VelocityRmse(FitCurve(c.stamps, c.positions), c), 0.0098);
 }
 
 }  // namespace

@@ -75,8 +75,8 @@ struct CurveOptions {
   /// end where the data on both sides say it is the better estimate (docs/velocity.md, "Gaps";
   /// WindowVerdict::kBridge). false keeps the end windows' own polynomials.
   bool end_caps = true;
-  /// With end_caps, segments of one or two windows (or with fewer samples between their end
-  /// windows than an end window holds) get caps too: chosen at artificial ends inside
+  /// With end_caps, segments of one or two windows (or with too little room between their end
+  /// windows to judge a cap there) get caps too: chosen at artificial ends inside
   /// the end window, where its own rate is the reference, and against its rate's variance at the
   /// end, σ²·dᵀG⁻¹d with the window's σ. The angular fit turns it off: its charts' noise varies
   /// along them (largest at their ends), and a chart's end lies where it is blended with the next.
