@@ -74,6 +74,7 @@ using internal::kLackOfFitLimit;
 using internal::kMaxGramCondition;
 using internal::kNoiseMargin;
 using internal::LackOfFitScore;
+using internal::RoundingFloor;
 using internal::WindowSigma;
 
 // Fits one window and, for automatic degrees, says whether it should be split instead.
@@ -322,11 +323,15 @@ class WindowFitter {
     window->noise_sigma = sigma;
     window->residual_rms.resize(d);
     window->lack_of_fit.resize(d);
+    window->reproduces_samples = d > 0;
     bool passes = true;
     for (Eigen::Index c = 0; c < d; ++c) {
       const double rss = residual.col(c).squaredNorm();
+      const Eigen::Index dof = m - window->degrees[c] - 1;
       window->residual_rms[c] = std::sqrt(rss / static_cast<double>(m));
-      window->lack_of_fit[c] = LackOfFitScore(rss, sigma[c], m - window->degrees[c] - 1);
+      window->lack_of_fit[c] = LackOfFitScore(rss, sigma[c], dof);
+      window->reproduces_samples = window->reproduces_samples && dof >= kExactResidualDof &&
+                                   window->residual_rms[c] <= RoundingFloor(z.col(c));
       passes = passes && window->lack_of_fit[c] <= kLackOfFitLimit;
     }
     return passes;

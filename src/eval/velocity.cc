@@ -333,12 +333,6 @@ traj::Trajectory VelocityTrajectory(const traj::TrajectoryView& input, const Vel
   return out;
 }
 
-// UnresolvedWarning: a residual RMS at most this times (1 + the values' range) in every coordinate
-// (m, or rad for the angular fit), with at least kExactResidualDof residual degrees of freedom,
-// reproduces the samples (cheb's RoundingFloor).
-constexpr double kExactResidual = 1e-9;
-constexpr Eigen::Index kExactResidualDof = 3;
-
 std::string UnresolvedWarning(const cheb::Curve& curve) {
   // The largest residual over the noise among the unresolved windows whose residual fails the
   // test, or among all unresolved windows where none fails: a window at the smallest size can also
@@ -351,32 +345,16 @@ std::string UnresolvedWarning(const cheb::Curve& curve) {
       if (window == nullptr || r > ratio) window = &w, ratio = r;
     }
   } failing_worst, any_worst;
-  // A window that reproduces its samples to their rounding level, with a few residual degrees of
-  // freedom to spare, has missed nothing its samples show, whatever its coefficients: exact data
-  // at a low rate (a simulator's file) leave such windows, and a warning about them would only
-  // mislead (motion between the samples that they do not resolve, no method can tell). The level
-  // is cheb's RoundingFloor, 1e-9·(1 + range) + 4 ulps of the largest value, with the range and the
-  // largest value bounded by the window's series (|T_k| ≤ 1).
-  auto reproduces_its_samples = [&](const cheb::CurveWindow& w) {
-    const Eigen::MatrixXd& a = w.series.coefficients;
-    if (a.rows() == 0 || a.cols() != w.residual_rms.size() || static_cast<Eigen::Index>(w.degrees.size()) != a.cols()) {
-      return false;
-    }
-    for (Eigen::Index c = 0; c < a.cols(); ++c) {
-      const double varying = a.col(c).tail(a.rows() - 1).cwiseAbs().sum();
-      const double floor = kExactResidual * (1.0 + 2.0 * varying) +
-                           4.0 * std::numeric_limits<double>::epsilon() * (std::abs(a(0, c)) + varying);
-      const auto dof = w.samples - w.degrees[static_cast<size_t>(c)] - 1;
-      if (!(w.residual_rms[c] <= floor) || dof < kExactResidualDof) return false;
-    }
-    return true;
-  };
+  // A window that reproduces its samples to their rounding level (CurveWindow::reproduces_samples)
+  // has missed nothing its samples show, whatever its coefficients: exact data at a low rate (a
+  // simulator's file) leave such windows, and a warning about them would only mislead (motion
+  // between the samples that they do not resolve, no method can tell).
   Eigen::Index failing = 0, undecided = 0;
   for (const cheb::CurveSegment& segment : curve.segments()) {
     for (const cheb::CurveWindow& w : segment.windows) {
       if (w.verdict != cheb::WindowVerdict::kUnresolved || w.residual_rms.size() != curve.dimension()) continue;
       const bool fails = w.lack_of_fit.size() > 0 && w.lack_of_fit.maxCoeff() > cheb::kLackOfFitLimit;
-      if (!fails && reproduces_its_samples(w)) continue;
+      if (!fails && w.reproduces_samples) continue;
       failing += fails ? 1 : 0;
       undecided += fails ? 0 : 1;
       // Against the σ the window was tested against (the noise profile's), where it has one.

@@ -149,6 +149,10 @@ inline constexpr double kLackOfFitLimit = 3.0;
 /// One window: its core [core_begin, core_end] (seconds from the curve's origin), the samples used
 /// and the fit, with a degree per coordinate (coefficients of lower-degree coordinates are padded
 /// with zeros).
+/// CurveWindow::reproduces_samples asks for at least this many residual degrees of freedom: a
+/// window with fewer could match its samples to rounding with any motion between them.
+inline constexpr Eigen::Index kExactResidualDof = 3;
+
 struct CurveWindow {
   double core_begin = 0, core_end = 0;
   double fit_begin = 0, fit_end = 0;
@@ -168,6 +172,11 @@ struct CurveWindow {
   /// The noise σ per coordinate the residual was tested against: the noise profile's over the
   /// window's samples (Curve::noisier_samples), floored at the values' rounding level (diagnostics).
   Eigen::VectorXd noise_sigma;
+  /// Its residual is at its values' rounding level in every coordinate (the floor of
+  /// `noise_sigma`), with at least kExactResidualDof residual degrees of freedom to spare: the
+  /// window reproduces its samples, whatever its coefficients say (exact data at a low rate leave
+  /// unresolved windows of this kind; diagnostics).
+  bool reproduces_samples = false;
   WindowVerdict verdict = WindowVerdict::kResolved;
   /// The window is a piece of a larger one that was split because it missed motion (its residual
   /// failed the lack-of-fit test, or its halves predicted held-out samples better).
