@@ -152,7 +152,9 @@ def main():
     parser.add_argument("--only", default="", help="keep the cases whose name contains this")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     args = parser.parse_args()
-    cases = [k for k in range(args.first, args.first + args.count) if args.only in draw_name(k)]
+    cases = range(args.first, args.first + args.count)
+    if args.only:  # drawn here for the name only; the case is drawn again where it is scored
+        cases = [k for k in cases if args.only in draw(k)[0]]
 
     print("velocity RMSE in mm/s, full range\n")
     print("| case | motion | cheval | central | SG best (win) | /central | /SG | flags |")
@@ -176,10 +178,6 @@ def main():
     print(f"{len(flagged)} case(s) failing a criterion: {' '.join(map(str, flagged))}")
     if failed:
         print(f"{failed} case(s) where cheval velocity failed")
-
-
-def draw_name(case):
-    return draw(case)[0]
 
 
 if __name__ == "__main__":
