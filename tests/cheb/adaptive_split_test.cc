@@ -200,5 +200,25 @@ TEST(EndCaps, EndsWithTooFewArtificialEndsBetweenThemAreCapped) {
   EXPECT_LT(VelocityRmse(FitCurve(c.stamps, c.positions), c), 0.0098);
 }
 
+// Exact positions at a low rate leave windows at the smallest size whose coefficients show no noise
+// plateau (accepted unresolved) while their residual is at the values' rounding level: the fit
+// marks them (CurveWindow::reproduces_samples), and `cheval velocity` does not warn of them. Under
+// noise no window is marked.
+TEST(ResidualTest, WindowsThatReproduceTheirSamplesAreMarked) {
+  const Case exact = Simulated(sim::MotionKind::kCar, 1, 0.0, 30.0, 20.0);
+  const Curve curve = FitCurve(exact.stamps, exact.positions);
+  ASSERT_GT(curve.unresolved_windows(), 0) << "the case no longer tests anything";
+  for (const CurveSegment& segment : curve.segments()) {
+    for (const CurveWindow& w : segment.windows) {
+      if (w.verdict != WindowVerdict::kUnresolved) continue;
+      EXPECT_TRUE(w.reproduces_samples) << w.fit_begin << ".." << w.fit_end << " s: residual " << w.residual_rms.transpose();
+    }
+  }
+  const Case noisy = Simulated(sim::MotionKind::kCar, 1, 0.5e-3, 30.0, 20.0);
+  for (const CurveSegment& segment : FitCurve(noisy.stamps, noisy.positions).segments()) {
+    for (const CurveWindow& w : segment.windows) EXPECT_FALSE(w.reproduces_samples) << w.fit_begin << " s";
+  }
+}
+
 }  // namespace
 }  // namespace cheval::cheb
