@@ -2,7 +2,7 @@
 """`cheval velocity` on random cases unlike the generators (docs/velocity.md, "Random cases").
 
 usage: /usr/bin/python3 bench/velocity_random.py [--cheval build/cheval] [--first 0] [--count 100]
-                                                [--only TEXT] [--jobs 2]
+                                                [--only TEXT] [--jobs 2] [--regions]
 
 Case k draws, from a generator seeded with k alone (so a case is the same whatever --first/--count):
 a motion (a few tones; a broad spectrum; stop-and-go legs with smoothstep speed profiles; a chirp; a
@@ -15,7 +15,11 @@ the ratios. Flags, as in bench/velocity_sweep.py: cheval/SG > 1 anywhere, cheval
 noise-free data (noise <= 1 um), cheval/central > 0.2 where noise dominates central differences' error
 (its noise part >= 10x its bias). At the end: the geometric mean of cheval/SG and the flagged cases.
 The baselines run across dropouts as if they were not there, which favours them where the motion is
-smooth. Runs `cheval velocity` through files. Exit 0 whatever the flags (a report, not a test).
+smooth. With --regions, each case also says where the two differ: cheval's RMSE over the oracle's
+at the recording's ends (the first and last 2 % of the samples, at least 3), next to dropouts (2
+samples either side of a step over 3 median steps) and elsewhere, and the geometric means of those
+ratios per noise level. Runs `cheval velocity` through files. Exit 0 whatever the flags (a report,
+not a test).
 """
 import argparse
 import concurrent.futures
@@ -134,6 +138,18 @@ def score(args):
     e_ch, vc = rms(mine - truth), central(t, p)
     e_c = rms(vc - truth)
     best, best_w = min((rms(savgol(t, p, w) - truth), w) for w in SG_WINDOWS if w <= len(t))
+    sg = savgol(t, p, best_w)
+    mine_sq, sg_sq = ((mine - truth) ** 2).sum(1), ((sg - truth) ** 2).sum(1)
+    steps = np.diff(t)
+    near_gap, ends = np.zeros(len(t), bool), np.zeros(len(t), bool)
+    for i in np.nonzero(steps > 3 * np.median(steps))[0]:
+        near_gap[max(0, i - 1):i + 3] = True
+    k = max(3, len(t) // 50)
+    ends[:k], ends[-k:] = True, True
+    regions = {}
+    for region, mask in (("ends", ends), ("gaps", near_gap & ~ends), ("rest", ~near_gap & ~ends)):
+        if mask.any() and sg_sq[mask].sum() > 0:
+            regions[region] = np.sqrt(mine_sq[mask].mean() / sg_sq[mask].mean())
     flags = []
     if e_ch > best:
         flags.append("SG")
@@ -141,7 +157,7 @@ def score(args):
         flags.append("central(noise-free)")
     if rms(vc - central(t, clean)) >= 10 * rms(central(t, clean) - truth) and e_ch > 0.2 * e_c:
         flags.append("0.2x central")
-    return case, name, (e_ch, e_c, best, best_w), flags
+    return case, name, (e_ch, e_c, best, best_w, regions, noise), flags
 
 
 def main():
@@ -151,31 +167,44 @@ def main():
     parser.add_argument("--count", type=int, default=100, help="number of cases")
     parser.add_argument("--only", default="", help="keep the cases whose name contains this")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--regions", action="store_true", help="where cheval and the oracle differ (ends, dropouts)")
     args = parser.parse_args()
     cases = range(args.first, args.first + args.count)
     if args.only:  # drawn here for the name only; the case is drawn again where it is scored
         cases = [k for k in cases if args.only in draw(k)[0]]
 
     print("velocity RMSE in mm/s, full range\n")
-    print("| case | motion | cheval | central | SG best (win) | /central | /SG | flags |")
-    print("|---|---|---|---|---|---|---|---|")
-    ratios, flagged, failed = [], [], 0
+    extra = " /SG ends | /SG gaps | /SG rest |" if args.regions else ""
+    print("| case | motion | cheval | central | SG best (win) | /central | /SG | flags |" + extra)
+    print("|---|---|---|---|---|---|---|---|" + "---|" * (3 if args.regions else 0))
+    ratios, flagged, failed, by_noise = [], [], 0, {}
     with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         for case, name, errors, flags in pool.map(score, [(args.cheval, k) for k in cases]):
             if errors is None:
                 failed += 1
                 print(f"| {case} | {name} | FAILED: {flags} |||||||", flush=True)
                 continue
-            e_ch, e_c, best, best_w = errors
+            e_ch, e_c, best, best_w, regions, noise = errors
             ratios.append(e_ch / best if best > 0 else 1.0)
             if flags:
                 flagged.append(case)
+            columns = ""
+            if args.regions:
+                columns = "".join(f" {regions[r]:.3f} |" if r in regions else " |" for r in ("ends", "gaps", "rest"))
+                for region, ratio in regions.items():
+                    by_noise.setdefault((noise, region), []).append(ratio)
             print(f"| {case} | {name} | {1e3 * e_ch:.4f} | {1e3 * e_c:.4f} | {1e3 * best:.4f} ({best_w}) | "
-                  f"{e_ch / e_c:.3f} | {e_ch / best:.3f} | {'FAIL ' + ', '.join(flags) if flags else ''} |",
+                  f"{e_ch / e_c:.3f} | {e_ch / best:.3f} | {'FAIL ' + ', '.join(flags) if flags else ''} |{columns}",
                   flush=True)
     if ratios:
         print(f"\ngeometric mean of cheval/SG over {len(ratios)} case(s): {np.exp(np.mean(np.log(ratios))):.3f}x")
     print(f"{len(flagged)} case(s) failing a criterion: {' '.join(map(str, flagged))}")
+    if by_noise:
+        print("\ncheval/SG by region, geometric mean over the cases (count), per noise level:")
+        for noise in sorted({n for n, _ in by_noise}):
+            parts = [f"{region} {np.exp(np.mean(np.log(by_noise[noise, region]))):.3f} ({len(by_noise[noise, region])})"
+                     for region in ("ends", "gaps", "rest") if (noise, region) in by_noise]
+            print(f"  {noise * 1e3:g} mm: " + ", ".join(parts))
     if failed:
         print(f"{failed} case(s) where cheval velocity failed")
 

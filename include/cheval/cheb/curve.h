@@ -146,13 +146,13 @@ std::string_view ToString(WindowVerdict verdict);
 /// stays at or below this (docs/velocity.md, "Residual test").
 inline constexpr double kLackOfFitLimit = 3.0;
 
-/// One window: its core [core_begin, core_end] (seconds from the curve's origin), the samples used
-/// and the fit, with a degree per coordinate (coefficients of lower-degree coordinates are padded
-/// with zeros).
 /// CurveWindow::reproduces_samples asks for at least this many residual degrees of freedom: a
 /// window with fewer could match its samples to rounding with any motion between them.
 inline constexpr Eigen::Index kExactResidualDof = 3;
 
+/// One window: its core [core_begin, core_end] (seconds from the curve's origin), the samples used
+/// and the fit, with a degree per coordinate (coefficients of lower-degree coordinates are padded
+/// with zeros).
 struct CurveWindow {
   double core_begin = 0, core_end = 0;
   double fit_begin = 0, fit_end = 0;
