@@ -405,6 +405,7 @@ std::string VelocityJson(const VelocityRun& run, const VelocityEstimate& estimat
           window["residual_rms_m"] = std::vector<double>(w.residual_rms.data(), w.residual_rms.data() + w.residual_rms.size());
           window["lack_of_fit"] = std::vector<double>(w.lack_of_fit.data(), w.lack_of_fit.data() + w.lack_of_fit.size());
           window["noise_sigma_m"] = std::vector<double>(w.noise_sigma.data(), w.noise_sigma.data() + w.noise_sigma.size());
+          window["reproduces_samples"] = w.reproduces_samples;
         }
         windows.push_back(std::move(window));
         degrees.insert(degrees.end(), w.degrees.begin(), w.degrees.end());
