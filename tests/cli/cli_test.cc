@@ -218,8 +218,6 @@ double ColumnRmse(const std::string& estimate, const std::string& truth, int fir
   return n > 0 ? std::sqrt(sum / n) : 1e9;
 }
 
-// Slow motion at 500 Hz written to the millimetre (docs/velocity.md, "Rounded positions"): a
-// staircase that is said, with its step, and fitted as motion.
 // Exact positions at 20 Hz leave unresolved windows whose residual is at the values' rounding
 // level: --json marks them, and stderr does not warn of them.
 TEST_F(CliTest, VelocityMarksWindowsThatReproduceExactSamples) {
@@ -237,6 +235,8 @@ TEST_F(CliTest, VelocityMarksWindowsThatReproduceExactSamples) {
   EXPECT_GT(unresolved, 0) << "the case no longer tests anything";
 }
 
+// Slow motion at 500 Hz written to the millimetre (docs/velocity.md, "Rounded positions"): a
+// staircase that is said, with its step, and fitted as motion.
 TEST_F(CliTest, VelocityOfRoundedPositionsSaysSo) {
   std::ofstream measured(Path("r.txt")), truth(Path("rt.txt"));
   for (int i = 0; i < 5000; ++i) {
