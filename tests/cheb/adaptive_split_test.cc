@@ -215,7 +215,8 @@ TEST(ResidualTest, WindowsThatReproduceTheirSamplesAreMarked) {
     }
   }
   const Case noisy = Simulated(sim::MotionKind::kCar, 1, 0.5e-3, 30.0, 20.0);
-  for (const CurveSegment& segment : FitCurve(noisy.stamps, noisy.positions).segments()) {
+  const Curve noisy_curve = FitCurve(noisy.stamps, noisy.positions);
+  for (const CurveSegment& segment : noisy_curve.segments()) {
     for (const CurveWindow& w : segment.windows) EXPECT_FALSE(w.reproduces_samples) << w.fit_begin << " s";
   }
 }
