@@ -74,7 +74,6 @@ using internal::kLackOfFitLimit;
 using internal::kMaxGramCondition;
 using internal::kNoiseMargin;
 using internal::LackOfFitScore;
-using internal::RoundingFloor;
 using internal::WindowSigma;
 
 // Fits one window and, for automatic degrees, says whether it should be split instead.
@@ -127,7 +126,9 @@ class WindowFitter {
       std::fill(window.degrees.begin(), window.degrees.end(), options_.fixed_degree);
       window.series = FitLeastSquares(tw, zw, options_.fixed_degree, interval);
       window.coefficient_magnitudes = window.series.coefficients.cwiseAbs();
-      LackOfFit(tw, zw, WindowSigma(noise_.Over(span.first, m), zw), &window);
+      Eigen::VectorXd floor;
+      const Eigen::VectorXd sigma = WindowSigma(noise_.Over(span.first, m), zw, &floor);
+      LackOfFit(tw, zw, sigma, floor, &window);
       window.verdict = WindowVerdict::kFixedDegree;
       Finish(&window);
       return window;
@@ -184,7 +185,8 @@ class WindowFitter {
     bool resolved = ChopDegrees(high, m, level, &window.degrees);
     // The chop looks for a plateau by shape, which a short noisy window can hide: when the top third
     // of the coefficients is statistically pure noise, the window is resolved anyway.
-    const Eigen::VectorXd sigma = WindowSigma(level, zw);
+    Eigen::VectorXd floor;
+    const Eigen::VectorXd sigma = WindowSigma(level, zw, &floor);
     if (!resolved) resolved = TailIsNoise(high, *cholesky, sigma);
     if (held_out != nullptr) held_out->resize(0);
     // No plateau and a tail above the noise say that the window *may* miss motion above its top
@@ -212,7 +214,7 @@ class WindowFitter {
     // would raise the degree to fit the noise: the raise tests against F instead of χ² there.
     window.series.interval = interval;
     SetDegrees(*cholesky, probe, &window);
-    bool consistent = LackOfFit(tw, zw, sigma, &window) || !options_.lack_of_fit;
+    bool consistent = LackOfFit(tw, zw, sigma, floor, &window) || !options_.lack_of_fit;
     if (!consistent) {
       const Centred centred = Centre(probe, zw);
       bool raised = false;
@@ -229,14 +231,14 @@ class WindowFitter {
       }
       if (raised) {
         SetDegrees(*cholesky, probe, &window);
-        consistent = LackOfFit(tw, zw, sigma, &window);
+        consistent = LackOfFit(tw, zw, sigma, floor, &window);
       }
     }
     if (!consistent && may_split) {
       if (missed != nullptr) *missed = true;
       return std::nullopt;
     }
-    LowerBelowRounding(tw, zw, sigma, *cholesky, probe, &window);
+    LowerBelowRounding(tw, zw, sigma, floor, *cholesky, probe, &window);
     if (arbitrate) *undecided = true;
     if (reusable != nullptr) *reusable = !may_split && stride < 2 && !lowered && resolved && consistent;
     window.verdict = (resolved || arbitrate) && consistent ? WindowVerdict::kResolved : WindowVerdict::kUnresolved;
@@ -312,10 +314,11 @@ class WindowFitter {
     return false;
   }
 
-  // Residuals of a window's series at its samples: fills residual_rms and lack_of_fit; whether
+  // Residuals of a window's series at its samples, tested against σ: fills residual_rms,
+  // lack_of_fit and reproduces_samples (`floor`: the samples' rounding level, WindowSigma); whether
   // every coordinate passes.
   bool LackOfFit(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
-                 const Eigen::VectorXd& sigma, CurveWindow* window) const {
+                 const Eigen::VectorXd& sigma, const Eigen::VectorXd& floor, CurveWindow* window) const {
     const Eigen::Index m = t.size(), d = z.cols();
     Eigen::VectorXd x(m);
     for (Eigen::Index i = 0; i < m; ++i) x[i] = window->series.interval.ToUnit(t[i]);
@@ -331,7 +334,7 @@ class WindowFitter {
       window->residual_rms[c] = std::sqrt(rss / static_cast<double>(m));
       window->lack_of_fit[c] = LackOfFitScore(rss, sigma[c], dof);
       window->reproduces_samples = window->reproduces_samples && dof >= kExactResidualDof &&
-                                   window->residual_rms[c] <= RoundingFloor(z.col(c));
+                                   window->residual_rms[c] <= floor[c];
       passes = passes && window->lack_of_fit[c] <= kLackOfFitLimit;
     }
     return passes;
@@ -343,8 +346,8 @@ class WindowFitter {
   // against that rounding level whose residual lies clearly below it takes the highest lower
   // degree of the grid whose residual does not.
   void LowerBelowRounding(const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& z,
-                          const Eigen::VectorXd& sigma, const NestedCholesky& cholesky, const NormalEquations& probe,
-                          CurveWindow* window) const {
+                          const Eigen::VectorXd& sigma, const Eigen::VectorXd& floor, const NestedCholesky& cholesky,
+                          const NormalEquations& probe, CurveWindow* window) const {
     const Eigen::Index m = t.size();
     bool lowered = false;
     std::optional<Centred> centred;
@@ -367,7 +370,7 @@ class WindowFitter {
     }
     if (lowered) {
       SetDegrees(cholesky, probe, window);
-      LackOfFit(t, z, sigma, window);
+      LackOfFit(t, z, sigma, floor, window);
     }
   }
 

@@ -39,11 +39,15 @@ inline double RoundingFloor(const Eigen::Ref<const Eigen::VectorXd>& z) {
 // ask for an exact fit. Not the window's own estimate: a short window's scatters by tens of per
 // cent, and taking the larger would let small unresolved motion pass as noise; the profile pools
 // 160 samples and departs from the data's level only by a factor that scatter does not reach
-// (NoiseProfile).
-inline Eigen::VectorXd WindowSigma(const Eigen::VectorXd& level, const Eigen::Ref<const Eigen::MatrixXd>& z) {
+// (NoiseProfile). With `floor`, that rounding level per coordinate too.
+inline Eigen::VectorXd WindowSigma(const Eigen::VectorXd& level, const Eigen::Ref<const Eigen::MatrixXd>& z,
+                                   Eigen::VectorXd* floor = nullptr) {
   Eigen::VectorXd sigma(z.cols());
+  if (floor != nullptr) floor->resize(z.cols());
   for (Eigen::Index c = 0; c < z.cols(); ++c) {
-    sigma[c] = std::max(level[c], RoundingFloor(z.col(c)));
+    const double rounding = RoundingFloor(z.col(c));
+    sigma[c] = std::max(level[c], rounding);
+    if (floor != nullptr) (*floor)[c] = rounding;
   }
   return sigma;
 }
