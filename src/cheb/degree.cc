@@ -309,8 +309,10 @@ Eigen::VectorXd DifferenceMagnitudes::Estimate(Eigen::Index begin, Eigen::Index 
     if (!(fourth > threshold[c])) continue;
     if (!sixth_scale) sixth_scale = scale_of(sixth_), eighth_scale = scale_of(eighth_);
     const double sixth = chosen(*sixth_scale), eighth = chosen(*eighth_scale);
-    if (sixth < keep6 * fourth) sigma[c] = sixth;
-    if (eighth < keep8 * fourth) sigma[c] = std::min(sigma[c], eighth);
+    // An order without a usable run has no scale, not a scale of 0: between the dropouts of a short
+    // recording (segments of 4–7 samples) the 8th differences have none, and σ read 0.
+    if (sixth_scale->runs > 0 && sixth < keep6 * fourth) sigma[c] = sixth;
+    if (eighth_scale->runs > 0 && eighth < keep8 * fourth) sigma[c] = std::min(sigma[c], eighth);
   }
   return sigma;
 }
