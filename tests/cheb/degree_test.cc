@@ -272,7 +272,7 @@ TEST(EstimateNoiseSigma, AnOrderWithoutRunsLeavesTheLevelAlone) {
   }
   breaks.pop_back();
   const auto m = static_cast<Eigen::Index>(times.size());
-  Eigen::VectorXd t = Eigen::Map<const Eigen::VectorXd>(times.data(), m);
+  const Eigen::VectorXd t = Eigen::Map<const Eigen::VectorXd>(times.data(), m);
   Eigen::MatrixXd z(m, 3);
   for (Eigen::Index i = 0; i < m; ++i) {
     for (Eigen::Index c = 0; c < 3; ++c) z(i, c) = 0.5 * std::sin(0.7 * t[i] + c) + noise(rng);

@@ -254,7 +254,8 @@ TEST(GapBridges, HoldAShortRecordingWhoseSegmentsAreShorterThanTheNoiseRuns) {
     cheval += std::pow(RateError(curve, r, false), 2);
     for (Eigen::Index i = 0; i < m; ++i) {  // central differences on the stamps, across the gaps
       const Eigen::Index a = std::max<Eigen::Index>(i - 1, 0), b = std::min(i + 1, m - 1);
-      const Eigen::RowVectorXd rate = (r.positions.row(b) - r.positions.row(a)) / (times[b] - times[a]);
+      const double span = times[static_cast<size_t>(b)] - times[static_cast<size_t>(a)];
+      const Eigen::RowVectorXd rate = (r.positions.row(b) - r.positions.row(a)) / span;
       chord += (rate - r.velocities.row(i)).squaredNorm() / static_cast<double>(m);
     }
   }
