@@ -20,7 +20,7 @@ import tempfile
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from velocity_sweep import central, rms, savgol  # noqa: E402
+from velocity_sweep import central, rms, savgol, simulate  # noqa: E402
 
 KINDS = ("car", "drone", "handheld", "legged")
 DURATIONS = (0.3, 0.5, 1.0, 2.0)
@@ -29,15 +29,10 @@ NOISES = (0.0005, 0.002)
 
 def clip(cheval, folder, kind, duration, noise, seed):
     """One clip's velocity RMSE (m/s): cheval's, at its first and last three samples, the oracle's, central differences'."""
-    measured, truth, out = (os.path.join(folder, name) for name in ("m.tum", "t.tum", "o.tum"))
-    subprocess.run([cheval, "sim", "motion", "--kind", kind, "--duration", str(duration), "--rate", "100",
-                    "--noise", str(noise), "--seed", str(seed), "-o", measured, "--truth", truth],
-                   check=True, capture_output=True)
+    measured, stamps, positions, v = simulate(cheval, folder, kind, duration, 100, noise, seed)
+    out = os.path.join(folder, "o.tum")
     subprocess.run([cheval, "velocity", measured, "-o", out, "--quiet"], check=True, capture_output=True)
-    m, t, o = np.loadtxt(measured), np.loadtxt(truth), np.loadtxt(out)
-    v = t[:, 8:11]
-    error = o[:, 8:11] - v
-    stamps, positions = m[:, 0], m[:, 1:4]
+    error = np.loadtxt(out)[:, 8:11] - v
     oracle = min(rms(savgol(stamps, positions, w) - v) for w in range(5, len(stamps) + 1, 2))
     return np.array([rms(error), rms(np.r_[error[:3], error[-3:]]), oracle, rms(central(stamps, positions) - v)])
 

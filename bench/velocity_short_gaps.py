@@ -27,7 +27,7 @@ import tempfile
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from velocity_sweep import SG_WINDOWS, central, rms, savgol  # noqa: E402
+from velocity_sweep import SG_WINDOWS, central, rms, savgol, simulate  # noqa: E402
 
 KINDS = ("car", "drone", "handheld", "legged")
 DROPOUTS = ((3, 0.3), (10, 0.1), (6, 0.5))
@@ -51,15 +51,10 @@ def score(args):
     kind, duration, rate, (gaps, gap_s), noise, seed = case
     name = name_of(case)
     with tempfile.TemporaryDirectory() as work:
-        measured, truth = os.path.join(work, "in.tum"), os.path.join(work, "truth.tum")
-        made = subprocess.run([cheval, "sim", "motion", "--kind", kind, "--duration", str(duration), "--rate",
-                               str(rate), "--gap-count", str(gaps), "--gap-seconds", str(gap_s), "--noise", str(noise),
-                               "--seed", str(seed), "-o", measured, "--truth", truth], capture_output=True, text=True)
-        if made.returncode != 0:
+        made = simulate(cheval, work, kind, duration, rate, noise, seed, (gaps, gap_s))
+        if made is None:
             return name, None
-        exact, data = np.loadtxt(truth, ndmin=2), np.loadtxt(measured, ndmin=2)
-        t, p = data[:, 0], data[:, 1:4]
-        v = exact[np.searchsorted(exact[:, 0], t - 1e-7), 8:11]  # the truth at the measured (kept) samples
+        measured, t, p, v = made
         mine = velocity(cheval, measured, os.path.join(work, "out.tum"))
         other = velocity(baseline, measured, os.path.join(work, "base.tum")) if baseline else None
     if mine is None or (baseline and other is None):
@@ -104,12 +99,14 @@ def main():
             print(f"| {name} | {samples} | {1e3 * e_ch:.4f} | {1e3 * e_c:.4f} | {1e3 * best:.4f} | "
                   f"{e_ch / best if best > 0 else 1.0:.3f} |{columns}", flush=True)
     if ratios:
-        print(f"\ngeometric mean of cheval/SG over {len(ratios)} case(s): {np.exp(np.mean(np.log(np.maximum(ratios, 1e-12)))):.3f}x, "
-              f"{sum(r > 1.0 for r in ratios)} above 1")
+        mean = np.exp(np.mean(np.log(np.maximum(ratios, 1e-12))))
+        above = sum(r > 1.0 for r in ratios)
+        print(f"\ngeometric mean of cheval/SG over {len(ratios)} case(s): {mean:.3f}x, {above} above 1")
     if against_baseline:
         r = np.array(against_baseline)
-        print(f"cheval/baseline: geometric mean {np.exp(np.mean(np.log(np.maximum(r, 1e-12)))):.4f}x, {int((r > 1.05).sum())} worse "
-              f"by over 5 %, {int((r < 0.95).sum())} better by over 5 %")
+        mean = np.exp(np.mean(np.log(np.maximum(r, 1e-12))))
+        print(f"cheval/baseline: geometric mean {mean:.4f}x, {int((r > 1.05).sum())} worse by over 5 %, "
+              f"{int((r < 0.95).sum())} better by over 5 %")
 
 
 if __name__ == "__main__":

@@ -132,6 +132,20 @@ def run_cheval(binary, work, t, p):
     return np.loadtxt(out)[:, 8:11]
 
 
+def simulate(binary, work, kind, duration, rate, noise, seed, gaps=(0, 0.0)):
+    """`cheval sim motion` into `work`/in.tum: (path, stamps, positions, the exact velocity at the kept samples), or
+    None where the simulator refuses the combination (dropouts longer than the recording)."""
+    measured, truth = os.path.join(work, "in.tum"), os.path.join(work, "truth.tum")
+    made = subprocess.run([binary, "sim", "motion", "--kind", kind, "--duration", str(duration), "--rate", str(rate),
+                           "--gap-count", str(gaps[0]), "--gap-seconds", str(gaps[1]), "--noise", str(noise),
+                           "--seed", str(seed), "-o", measured, "--truth", truth], capture_output=True, text=True)
+    if made.returncode != 0:
+        return None
+    exact, data = np.loadtxt(truth, ndmin=2), np.loadtxt(measured, ndmin=2)
+    t = data[:, 0]
+    return measured, t, data[:, 1:4], exact[np.searchsorted(exact[:, 0], t - 1e-7), 8:11]
+
+
 # ---------------------------------------------------------------- cases
 def synthetic_cases(seed=0):
     """(name, t, measured p, true v, noise-free p) for the synthetic sweep; seed 0 is the published one."""
