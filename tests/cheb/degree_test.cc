@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "cheval/cheb/fit.h"
+#include "synthetic_motion.h"
 
 namespace cheval::cheb {
 namespace {
@@ -262,15 +263,8 @@ TEST(EstimateNoiseSigma, AnOrderWithoutRunsLeavesTheLevelAlone) {
   constexpr double kSigma = 2e-3;
   std::mt19937_64 rng(7);
   std::normal_distribution<double> noise(0.0, kSigma);
-  std::vector<double> times;
   std::vector<Eigen::Index> breaks;
-  double at = 0.0;
-  for (int segment = 0; segment < 12; ++segment) {
-    for (int i = 0; i < 5 + segment % 3; ++i, at += 0.02) times.push_back(at);
-    breaks.push_back(static_cast<Eigen::Index>(times.size()) - 1);  // a dropout after each segment
-    at += 0.1;
-  }
-  breaks.pop_back();
+  const std::vector<double> times = testing_motion::SegmentedStamps(12, &breaks);
   const auto m = static_cast<Eigen::Index>(times.size());
   const Eigen::VectorXd t = Eigen::Map<const Eigen::VectorXd>(times.data(), m);
   Eigen::MatrixXd z(m, 3);

@@ -23,6 +23,7 @@ namespace cheval::cheb {
 namespace {
 
 using testing_motion::EvaluateTones;
+using testing_motion::SegmentedStamps;
 using testing_motion::SweepTones;
 using testing_motion::Tone;
 
@@ -233,11 +234,7 @@ TEST(GapBridges, HoldAShortRecordingWhoseSegmentsAreShorterThanTheNoiseRuns) {
     const std::vector<Tone> tones = SweepTones(0.5, &rng);
     std::normal_distribution<double> gauss(0.0, 0.002);
     Recording r;
-    std::vector<double> times;
-    double at = 0.0;
-    for (int segment = 0; segment < 12; ++segment, at += 0.1) {
-      for (int i = 0; i < 5 + segment % 3; ++i, at += 0.02) times.push_back(at);
-    }
+    const std::vector<double> times = SegmentedStamps(12);
     const auto m = static_cast<Eigen::Index>(times.size());
     r.positions.resize(m, 3);
     r.velocities.resize(m, 3);

@@ -1,7 +1,7 @@
 #pragma once
 // Synthetic motion for the velocity fit's tests: sums of sinusoids per axis, sampled evenly, with
 // their exact velocity (tests/cheb/under_resolved_test.cc, local_regression_test.cc,
-// robust_curve_test.cc).
+// robust_curve_test.cc, gap_bridges_test.cc, degree_test.cc).
 
 #include <cmath>
 #include <cstdint>
@@ -21,6 +21,19 @@ struct Tone {
   int axis;
   double hz, amplitude, phase;  // position amplitude (m)
 };
+
+// The stamps (s) of a short recording cut up by dropouts: `segments` segments of 5, 6, 7, 5, ...
+// samples at 50 Hz, 0.1 s of dropout after each. `breaks`, when given, gets each segment's last
+// sample but the recording's (the boundaries no difference is taken across).
+inline std::vector<double> SegmentedStamps(int segments, std::vector<Eigen::Index>* breaks = nullptr) {
+  std::vector<double> times;
+  double at = 0.0;
+  for (int segment = 0; segment < segments; ++segment, at += 0.1) {
+    for (int i = 0; i < 5 + segment % 3; ++i, at += 0.02) times.push_back(at);
+    if (breaks != nullptr && segment + 1 < segments) breaks->push_back(static_cast<Eigen::Index>(times.size()) - 1);
+  }
+  return times;
+}
 
 // Per axis six tones of log-uniform frequency from 0.05 Hz up to f_max (one at it), ~0.3 m/s in
 // all: bench/velocity_sweep.py's "tones" motion, drawn from `rng`.
