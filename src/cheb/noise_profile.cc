@@ -270,7 +270,11 @@ NoiseProfile::NoiseProfile(const Eigen::VectorXd& level, const DifferenceMagnitu
   Eigen::VectorXd largest = Eigen::VectorXd::Zero(d);  // the largest variance per coordinate
   Eigen::MatrixXd bursts = Eigen::MatrixXd::Zero(blocks, d);
   for (Eigen::Index b = 0; b < blocks; ++b) {
-    const Eigen::Index begin = b * kBlock, end = std::min(m, begin + kBlock);
+    // The last block, when short, is judged with the one before it: over its few differences the
+    // estimate scatters past kBurst, and the higher orders, which see past the motion, have fewer
+    // runs or none (a chirp's fastest end read as a burst).
+    const Eigen::Index end = std::min(m, (b + 1) * kBlock);
+    const Eigen::Index begin = (b > 0 && end - b * kBlock < kBlock) ? (b - 1) * kBlock : b * kBlock;
     if (!may_exceed(burst_counts, begin, end)) continue;
     const Eigen::VectorXd threshold = kBurst * base_over(begin, end);
     const Eigen::VectorXd own = magnitudes.SigmaIfAbove(begin, end, threshold);

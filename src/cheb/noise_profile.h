@@ -126,7 +126,8 @@ inline bool AtRoundingLevel(double sigma, double rounding) {
 /// stationary noise), or whose estimate over the block alone exceeds it by more than kBurst (the
 /// same for the block's scatter, far wider): a burst of noise shorter than half the pool, which
 /// its median does not see (TUM fr2/desk's motion capture: tens of samples at ~10x the level).
-/// That raise covers the blocks on either side as well: a burst's edges half fill theirs.
+/// That raise covers the blocks on either side as well: a burst's edges half fill theirs. The last
+/// block, when shorter than kBlock, is judged for a burst with the block before it.
 class NoiseProfile {
  public:
   static constexpr Eigen::Index kBlock = 32;
