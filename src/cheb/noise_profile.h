@@ -18,7 +18,7 @@ inline constexpr double kMadScale = 1.4826;
 /// as std::nth_element finds it; `values` may be reordered and shrunk.
 double SelectNonNegative(std::vector<double>* values, size_t k);
 
-/// The magnitudes of the 4th, 6th and 8th divided differences of every run of 5, 7 and 9
+/// The magnitudes of the 2nd, 4th, 6th and 8th divided differences of every run of 3, 5, 7 and 9
 /// consecutive samples (EstimateNoiseSigma(t, z, breaks), which is built on it in degree.cc),
 /// kept per run so that the estimate can be taken over any stretch of the samples.
 class DifferenceMagnitudes {
@@ -29,7 +29,8 @@ class DifferenceMagnitudes {
 
   /// EstimateNoiseSigma's estimate from the runs that start at samples [begin, end): kMadScale ·
   /// the median magnitude, or over fewer than kWinsorizedBelow samples Huber's winsorized scale
-  /// where the differences' tails are white noise's (docs/velocity.md, "Noise estimate").
+  /// where the differences' tails are white noise's, lowered to a higher order's only where the
+  /// orders together show motion in the 4th differences (docs/velocity.md, "Noise estimate").
   Eigen::VectorXd Sigma(Eigen::Index begin, Eigen::Index end) const;
   /// The median's estimate where it exceeds `threshold` (per coordinate); elsewhere a value no
   /// larger than `threshold`: the 4th differences' estimate, which the higher orders only ever
@@ -59,10 +60,13 @@ class DifferenceMagnitudes {
   static constexpr Eigen::Index kWinsorizedBelow = 300;
 
  private:
+  // `drops_need_evidence`: a higher order lowers the estimate only where the orders together show
+  // motion in the 4th differences (the level); else wherever it is lower by more than white noise's
+  // scatter allows (a stretch's raise over the level, which a drop only ever withholds).
   Eigen::VectorXd Estimate(Eigen::Index begin, Eigen::Index end, const Eigen::VectorXd& threshold,
-                           bool winsorized) const;
+                           bool winsorized, bool drops_need_evidence) const;
 
-  Eigen::MatrixXd fourth_, sixth_, eighth_;  // m x d, NaN where no usable run starts
+  Eigen::MatrixXd second_, fourth_, sixth_, eighth_;  // m x d, NaN where no usable run starts
   Eigen::MatrixXd rates_;
 };
 
