@@ -331,7 +331,8 @@ Eigen::VectorXd DifferenceMagnitudes::Estimate(Eigen::Index begin, Eigen::Index 
       auto deviations = [](double change, double spread, size_t runs) {
         return runs == 0 ? 0.0 : change * std::sqrt(static_cast<double>(runs)) / spread;
       };
-      const double rise = scale_of(second_).median / fourth_scale.median - 1.0;
+      const double second = ScaleOf(second_, begin, end, c, /*with_winsorized=*/false, &scratch).median;
+      const double rise = second / fourth_scale.median - 1.0;
       const double evidence = deviations(rise, kRatioSpread2, fourth_scale.runs) +
                               deviations(1.0 - sixth / fourth, kRatioSpread6, sixth_scale->runs) +
                               deviations(1.0 - eighth / fourth, kRatioSpread8, eighth_scale->runs);

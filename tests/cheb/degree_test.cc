@@ -281,9 +281,10 @@ TEST(EstimateNoiseSigma, AnOrderWithoutRunsLeavesTheLevelAlone) {
 
 // The few runs of 6th differences in a short recording cut up by dropouts (one per segment of 7
 // samples here) read a fifth below the 4th's by chance, and σ read low: a car at 50 Hz under 2 mm
-// read 0.3 mm from one run. Where the 2nd differences are no larger than the 4th, the 4th are
-// noise, and the level is theirs. Slow motion (its 2nd differences 40 µm) under 2 mm, 100 draws:
-// 47 of 300 coordinates read below 0.6σ before, 8 now.
+// read 0.3 mm from one run. The level now drops to a higher order only where the three orders'
+// ratios to the 4th, each counted in white noise's deviations, together show motion in the 4th
+// differences. Slow motion (its 2nd differences 40 µm) under 2 mm, 100 draws: 47 of 300
+// coordinates read below 0.6σ before, 8 now.
 TEST(EstimateNoiseSigma, AFewHigherOrderRunsDoNotLowerTheLevelOfNoise) {
   constexpr double kSigma = 2e-3;
   std::vector<Eigen::Index> breaks;
