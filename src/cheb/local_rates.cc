@@ -114,12 +114,18 @@ constexpr double kUnderResolved = 0.5;
 // interpolating spline through them too. DIDO's motion capture, whose stamps alternate steps of
 // 0.24–0.7 ms with steps of 4–5 ms, was 20x its noise off at such pairs (docs/velocity.md, "Local
 // interpolant").
+// A step at exactly that fraction is not close: one dropped sample of an even grid puts a step
+// beside one twice as long, and the steps' rounding (stamps of whole nanoseconds, as seconds from
+// the first) must not decide. It did at segment ends, where the close end step left the end
+// sample without a slope (a 10 Hz hand-held recording with dropouts: 4.4 m/s off at its last
+// sample, where the motion is under 1 m/s).
 bool Close(const Eigen::VectorXd& h, Eigen::Index j) {
+  constexpr double kStampResolution = 1e-9;  // s
   const Eigen::Index n = h.size();
   double beside = std::numeric_limits<double>::infinity();
   if (j >= 1) beside = h[j - 1];
   if (j + 1 < n) beside = std::min(beside, h[j + 1]);
-  return std::isfinite(beside) && h[j] > 0.0 && h[j] < kCloseStep * beside;
+  return std::isfinite(beside) && h[j] > 0.0 && h[j] + kStampResolution < kCloseStep * beside;
 }
 
 }  // namespace
