@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -29,6 +30,10 @@ namespace {
 constexpr int kLanes = 8;
 constexpr int kChunk = 512;  // a multiple of kLanes
 
+// Vectors of 4 (AVX2) and 8 (AVX-512) doubles, for the kernels that spell their vectors out.
+using Vector4 = double __attribute__((vector_size(4 * sizeof(double))));
+using Vector8 = double __attribute__((vector_size(8 * sizeof(double))));
+
 struct Moments {
   std::vector<double> s;         // S_n, n = 0..2N
   std::vector<double> squares;   // Σω T_n², n = 0..N
@@ -47,6 +52,17 @@ struct Moments {
 #define CHEVAL_MULTIVERSION
 #endif
 
+// Whether the CPU has AVX-512's 32 vector registers of 8 doubles; the kernels below keep more
+// values in registers when it does.
+bool WideVectors() {
+#if defined(__x86_64__) && defined(__GNUC__)
+  static const bool wide = __builtin_cpu_supports("avx512f");
+  return wide;
+#else
+  return false;
+#endif
+}
+
 // Adds one chunk's contribution. Arrays have kChunk entries; wz is d x kChunk. kWeighted = false
 // means every weight is 1 (w is not read and wz holds z): the same sums without the multiplies, so
 // the results are bit-identical to the weighted kernel with unit weights. Padding needs ω = 0, so
@@ -54,72 +70,103 @@ struct Moments {
 //
 // Two degrees per sweep: with A = T_n and B = T_{n+1} loaded once, the sums of degrees n and n + 1
 // are accumulated and T_{n+2}, T_{n+3} are written back in place, which halves the loads and
-// stores per sample and degree. Every sum still adds the same terms in the same order (lane l of
-// an accumulator takes the samples k ≡ l mod kLanes, in increasing k), so nothing changes but speed.
-template <int D, bool kWeighted>
+// stores per sample and degree. Lane l of an accumulator takes the samples k ≡ l mod kLanes, in
+// increasing k, so every sum adds the same terms in the same order however the lanes are swept.
+// They are swept one Vector (kWidth lanes) at a time, so that a sweep's 6 + 2d accumulators stay
+// in registers: all 8 lanes at once fit AVX-512's 32 registers; on AVX2's 16 they spilled to the
+// stack at every sample (twice the time of 4 lanes at a time, `BM_FitLeastSquares`).
+template <int D, bool kWeighted, typename Vector>
 CHEVAL_MULTIVERSION void AccumulateChunk(const double* x, const double* w, const double* wz, int degree,
                                          Moments* moments) {
+  constexpr int kWidth = static_cast<int>(sizeof(Vector) / sizeof(double));
+  static_assert(kLanes % kWidth == 0);
   alignas(64) double t_a[kChunk], t_b[kChunk], two_x[kChunk];
   for (int k = 0; k < kChunk; ++k) {
     t_a[k] = 1.0;
     t_b[k] = x[k];
     two_x[k] = 2.0 * x[k];
   }
-  auto store = [moments](int n, const double* acc_s, const double* acc_sq, const double* acc_prod,
-                         const double (*acc_b)[kLanes]) {
+  // Unaligned-safe loads and stores of kWidth doubles (an out-parameter: a function returning a
+  // vector changes the ABI between the clones).
+  auto load = [](const double* p, Vector& v) { std::memcpy(&v, p, sizeof(v)); };
+  auto put = [](double* p, const Vector& v) { std::memcpy(p, &v, sizeof(v)); };
+  // One degree's sums, lane by lane.
+  struct Sums {
+    alignas(64) double s[kLanes], sq[kLanes], prod[kLanes], b[D][kLanes];
+  };
+  auto store = [moments](int n, const Sums& sums) {
     double s = 0, sq = 0, prod = 0;
-    for (int l = 0; l < kLanes; ++l) s += acc_s[l], sq += acc_sq[l], prod += acc_prod[l];
+    for (int l = 0; l < kLanes; ++l) s += sums.s[l], sq += sums.sq[l], prod += sums.prod[l];
     moments->s[n] += s;
     moments->squares[n] += sq;
     moments->products[n] += prod;
     for (int c = 0; c < D; ++c) {
       double bc = 0;
-      for (int l = 0; l < kLanes; ++l) bc += acc_b[c][l];
+      for (int l = 0; l < kLanes; ++l) bc += sums.b[c][l];
       moments->b(n, c) += bc;
     }
   };
+  const Vector zero = Vector{} + 0.0;
   int n = 0;
   for (; n + 1 <= degree; n += 2) {
     // Here t_a = T_n and t_b = T_{n+1}.
-    double s0[kLanes] = {}, sq0[kLanes] = {}, prod0[kLanes] = {}, b0[D][kLanes] = {};
-    double s1[kLanes] = {}, sq1[kLanes] = {}, prod1[kLanes] = {}, b1[D][kLanes] = {};
-    for (int k = 0; k < kChunk; k += kLanes) {
-      for (int l = 0; l < kLanes; ++l) {
-        const double tn = t_a[k + l], tn1 = t_b[k + l];
-        const double tn2 = two_x[k + l] * tn1 - tn;
-        const double tn3 = two_x[k + l] * tn2 - tn1;
-        const double wtn = kWeighted ? w[k + l] * tn : tn;
-        const double wtn1 = kWeighted ? w[k + l] * tn1 : tn1;
-        s0[l] += wtn;
-        sq0[l] += wtn * tn;
-        prod0[l] += wtn * tn1;
-        s1[l] += wtn1;
-        sq1[l] += wtn1 * tn1;
-        prod1[l] += wtn1 * tn2;
+    Sums first, second;
+    for (int l0 = 0; l0 < kLanes; l0 += kWidth) {
+      Vector s0 = zero, sq0 = zero, prod0 = zero, s1 = zero, sq1 = zero, prod1 = zero, b0[D], b1[D];
+      for (int c = 0; c < D; ++c) b0[c] = b1[c] = zero;
+      for (int k = l0; k < kChunk; k += kLanes) {
+        Vector tn, tn1, tx, wk = zero;
+        load(t_a + k, tn), load(t_b + k, tn1), load(two_x + k, tx);
+        if constexpr (kWeighted) load(w + k, wk);
+        const Vector tn2 = tx * tn1 - tn;
+        const Vector tn3 = tx * tn2 - tn1;
+        const Vector wtn = kWeighted ? wk * tn : tn;
+        const Vector wtn1 = kWeighted ? wk * tn1 : tn1;
+        s0 += wtn;
+        sq0 += wtn * tn;
+        prod0 += wtn * tn1;
+        s1 += wtn1;
+        sq1 += wtn1 * tn1;
+        prod1 += wtn1 * tn2;
         for (int c = 0; c < D; ++c) {
-          b0[c][l] += wz[c * kChunk + k + l] * tn;
-          b1[c][l] += wz[c * kChunk + k + l] * tn1;
+          Vector wzk;
+          load(wz + c * kChunk + k, wzk);
+          b0[c] += wzk * tn;
+          b1[c] += wzk * tn1;
         }
-        t_a[k + l] = tn2;
-        t_b[k + l] = tn3;
+        put(t_a + k, tn2);
+        put(t_b + k, tn3);
       }
+      put(first.s + l0, s0), put(first.sq + l0, sq0), put(first.prod + l0, prod0);
+      put(second.s + l0, s1), put(second.sq + l0, sq1), put(second.prod + l0, prod1);
+      for (int c = 0; c < D; ++c) put(first.b[c] + l0, b0[c]), put(second.b[c] + l0, b1[c]);
     }
-    store(n, s0, sq0, prod0, b0);
-    store(n + 1, s1, sq1, prod1, b1);
+    store(n, first);
+    store(n + 1, second);
   }
   if (n == degree) {
-    double s0[kLanes] = {}, sq0[kLanes] = {}, prod0[kLanes] = {}, b0[D][kLanes] = {};
-    for (int k = 0; k < kChunk; k += kLanes) {
-      for (int l = 0; l < kLanes; ++l) {
-        const double tn = t_a[k + l], tn1 = t_b[k + l];
-        const double wtn = kWeighted ? w[k + l] * tn : tn;
-        s0[l] += wtn;
-        sq0[l] += wtn * tn;
-        prod0[l] += wtn * tn1;
-        for (int c = 0; c < D; ++c) b0[c][l] += wz[c * kChunk + k + l] * tn;
+    Sums last;
+    for (int l0 = 0; l0 < kLanes; l0 += kWidth) {
+      Vector s0 = zero, sq0 = zero, prod0 = zero, b0[D];
+      for (int c = 0; c < D; ++c) b0[c] = zero;
+      for (int k = l0; k < kChunk; k += kLanes) {
+        Vector tn, tn1, wk = zero;
+        load(t_a + k, tn), load(t_b + k, tn1);
+        if constexpr (kWeighted) load(w + k, wk);
+        const Vector wtn = kWeighted ? wk * tn : tn;
+        s0 += wtn;
+        sq0 += wtn * tn;
+        prod0 += wtn * tn1;
+        for (int c = 0; c < D; ++c) {
+          Vector wzk;
+          load(wz + c * kChunk + k, wzk);
+          b0[c] += wzk * tn;
+        }
       }
+      put(last.s + l0, s0), put(last.sq + l0, sq0), put(last.prod + l0, prod0);
+      for (int c = 0; c < D; ++c) put(last.b[c] + l0, b0[c]);
     }
-    store(n, s0, sq0, prod0, b0);
+    store(n, last);
   }
 }
 
@@ -129,6 +176,7 @@ void AccumulateAll(const Eigen::VectorXd& x, const double* w, const Eigen::Ref<c
                    Moments* moments) {
   alignas(64) double cx[kChunk], cw[kChunk], cwz[D * kChunk];
   const Eigen::Index m = x.size();
+  const bool wide = WideVectors();
   for (Eigen::Index begin = 0; begin < m; begin += kChunk) {
     const int count = static_cast<int>(std::min<Eigen::Index>(kChunk, m - begin));
     for (int k = 0; k < kChunk; ++k) {
@@ -138,10 +186,15 @@ void AccumulateAll(const Eigen::VectorXd& x, const double* w, const Eigen::Ref<c
       cw[k] = wk;
       for (int c = 0; c < D; ++c) cwz[c * kChunk + k] = live ? wk * z(begin + k, c) : 0.0;
     }
-    if (w == nullptr && count == kChunk) {
-      AccumulateChunk<D, false>(cx, cw, cwz, degree, moments);
+    const bool unit = w == nullptr && count == kChunk;
+    if (unit && wide) {
+      AccumulateChunk<D, false, Vector8>(cx, cw, cwz, degree, moments);
+    } else if (unit) {
+      AccumulateChunk<D, false, Vector4>(cx, cw, cwz, degree, moments);
+    } else if (wide) {
+      AccumulateChunk<D, true, Vector8>(cx, cw, cwz, degree, moments);
     } else {
-      AccumulateChunk<D, true>(cx, cw, cwz, degree, moments);
+      AccumulateChunk<D, true, Vector4>(cx, cw, cwz, degree, moments);
     }
   }
 }
@@ -341,41 +394,59 @@ ChebyshevSeries FitLeastSquares(const Eigen::Ref<const Eigen::VectorXd>& t, cons
                               variance_factors);
 }
 
+namespace {
+
+// Clenshaw's sums of one column a[0..n] at the points x[0..m): kVectors Vectors of points at a
+// time, independent chains that stay in registers. One vector of chains is bound by the latency
+// of its multiply-add; enough of them keep the FMA ports busy. Each point's recurrence is the same
+// arithmetic whatever kVectors is.
+template <typename Vector, int kVectors>
+[[gnu::always_inline]] inline void ClenshawColumn(const double* a, Eigen::Index n, const double* x, Eigen::Index m,
+                                                  double* out) {
+  constexpr int kPoints = kVectors * static_cast<int>(sizeof(Vector) / sizeof(double));
+  for (Eigen::Index begin = 0; begin < m; begin += kPoints) {
+    const int count = static_cast<int>(std::min<Eigen::Index>(kPoints, m - begin));
+    alignas(64) double lanes[kPoints];
+    for (int p = 0; p < kPoints; ++p) lanes[p] = 2.0 * (p < count ? x[begin + p] : 0.0);
+    Vector two_x[kVectors], b1[kVectors], b2[kVectors];
+    std::memcpy(two_x, lanes, sizeof(two_x));
+    for (int v = 0; v < kVectors; ++v) {
+      b1[v] = Vector{} + 0.0;
+      b2[v] = Vector{} + 0.0;
+    }
+    for (Eigen::Index k = n; k >= 1; --k) {
+      const double ak = a[k];
+#pragma GCC unroll 8
+      for (int v = 0; v < kVectors; ++v) {
+        const Vector b0 = two_x[v] * b1[v] - b2[v] + ak;
+        b2[v] = b1[v];
+        b1[v] = b0;
+      }
+    }
+    alignas(64) double last[kPoints], before_last[kPoints];
+    std::memcpy(last, b1, sizeof(last));
+    std::memcpy(before_last, b2, sizeof(before_last));
+    for (int p = 0; p < count; ++p) out[begin + p] = x[begin + p] * last[p] - before_last[p] + a[0];
+  }
+}
+
+}  // namespace
+
 CHEVAL_MULTIVERSION Eigen::MatrixXd EvaluateSeries(const Eigen::Ref<const Eigen::MatrixXd>& coefficients,
                                                    const Eigen::Ref<const Eigen::VectorXd>& x) {
   const Eigen::Index n = coefficients.rows() - 1, m = x.size(), d = coefficients.cols();
   Eigen::MatrixXd result(m, d);
-  // kPoints points at a time: independent Clenshaw chains, in kVectors vectors of kLanes that stay
-  // in registers. One vector of chains is bound by the latency of its multiply-add; 8 of them keep
-  // the FMA ports busy. Each point's recurrence is the same arithmetic in any case.
-  using Vector = double __attribute__((vector_size(kLanes * sizeof(double))));
-  constexpr int kVectors = 8, kPoints = kVectors * kLanes;
+  // As many chains as the registers hold: a chain's vector takes three registers (2x, b_{k+1},
+  // b_{k+2}). AVX-512 has 32 registers of 8 lanes, so 8 vectors of 8 fit; AVX2's 16 registers of
+  // 4 lanes hold 4 vectors of 4 (2, 6 and 8 were slower). 8 vectors of 8 on AVX2 spilled to the
+  // stack at every step: 11x the time (`BM_EvaluateSeries`).
+  const bool wide = WideVectors();
   for (Eigen::Index c = 0; c < d; ++c) {
     const double* a = coefficients.col(c).data();
-    for (Eigen::Index begin = 0; begin < m; begin += kPoints) {
-      const int count = static_cast<int>(std::min<Eigen::Index>(kPoints, m - begin));
-      Vector two_x[kVectors], b1[kVectors], b2[kVectors];
-      for (int v = 0; v < kVectors; ++v) {
-        for (int l = 0; l < kLanes; ++l) {
-          const int p = v * kLanes + l;
-          two_x[v][l] = 2.0 * (p < count ? x[begin + p] : 0.0);
-        }
-        b1[v] = Vector{} + 0.0;
-        b2[v] = Vector{} + 0.0;
-      }
-      for (Eigen::Index k = n; k >= 1; --k) {
-        const double ak = a[k];
-#pragma GCC unroll 8
-        for (int v = 0; v < kVectors; ++v) {
-          const Vector b0 = two_x[v] * b1[v] - b2[v] + ak;
-          b2[v] = b1[v];
-          b1[v] = b0;
-        }
-      }
-      for (int p = 0; p < count; ++p) {
-        const int v = p / kLanes, l = p % kLanes;
-        result(begin + p, c) = x[begin + p] * b1[v][l] - b2[v][l] + a[0];
-      }
+    if (wide) {
+      ClenshawColumn<Vector8, 8>(a, n, x.data(), m, result.col(c).data());
+    } else {
+      ClenshawColumn<Vector4, 4>(a, n, x.data(), m, result.col(c).data());
     }
   }
   return result;
