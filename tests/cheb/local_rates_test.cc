@@ -19,24 +19,29 @@ namespace {
 
 constexpr double kRate = 100.0, kNoise = 1e-5;
 
-// One coordinate of smooth motion, 0.2 m/s at 0.3 Hz, sampled at kRate with noise kNoise, and its
-// true rate.
+// One coordinate of smooth motion, 0.2 m/s at 0.3 Hz, sampled at the times t with noise kNoise,
+// and its true rate.
 struct Samples {
   Eigen::VectorXd t;
   Eigen::MatrixXd z, rate;
 };
 
-Samples Smooth(Eigen::Index m, uint64_t seed) {
+Samples Smooth(const Eigen::VectorXd& t, uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> gauss(0.0, kNoise);
   const double w = 2.0 * M_PI * 0.3, amplitude = 0.2 / w;
-  Samples s{Eigen::VectorXd(m), Eigen::MatrixXd(m, 1), Eigen::MatrixXd(m, 1)};
+  const Eigen::Index m = t.size();
+  Samples s{t, Eigen::MatrixXd(m, 1), Eigen::MatrixXd(m, 1)};
   for (Eigen::Index i = 0; i < m; ++i) {
-    s.t[i] = static_cast<double>(i) / kRate;
-    s.z(i, 0) = amplitude * std::sin(w * s.t[i]) + gauss(rng);
-    s.rate(i, 0) = amplitude * w * std::cos(w * s.t[i]);
+    s.z(i, 0) = amplitude * std::sin(w * t[i]) + gauss(rng);
+    s.rate(i, 0) = amplitude * w * std::cos(w * t[i]);
   }
   return s;
+}
+
+// The same, m samples at kRate.
+Samples Smooth(Eigen::Index m, uint64_t seed) {
+  return Smooth(Eigen::VectorXd::LinSpaced(m, 0.0, static_cast<double>(m - 1)) / kRate, seed);
 }
 
 // The rates of one run over every sample, each local with the 3-point rate.
@@ -82,18 +87,13 @@ TEST(LocalRates, AStepBesideADroppedSampleKeepsItsSlope) {
   for (int64_t k = 0; k <= 50; ++k) {
     if (k != 2 && k != 20 && k != 23 && k != 48) kept.push_back(k);
   }
-  const auto m = static_cast<Eigen::Index>(kept.size());
-  const double w = 2.0 * M_PI * 0.3, amplitude = 0.2 / w;
-  Samples s{Eigen::VectorXd(m), Eigen::MatrixXd(m, 1), Eigen::MatrixXd(m, 1)};
-  for (Eigen::Index i = 0; i < m; ++i) {
-    s.t[i] = static_cast<double>(kept[static_cast<size_t>(i)] * 100'000'000) * 1e-9;
-    s.z(i, 0) = amplitude * std::sin(w * s.t[i] + 1.0);
-    s.rate(i, 0) = amplitude * w * std::cos(w * s.t[i] + 1.0);
-  }
+  Eigen::VectorXd t(static_cast<Eigen::Index>(kept.size()));
+  for (Eigen::Index i = 0; i < t.size(); ++i) t[i] = static_cast<double>(kept[static_cast<size_t>(i)] * 100'000'000) * 1e-9;
+  const Samples s = Smooth(t, 1);
   const Eigen::VectorXd rates = LocalRatesOf(s);
   // The 3-point rates' bias on this motion at steps of 0.1–0.2 s is under 4 mm/s.
-  for (Eigen::Index i = 0; i < m; ++i) {
-    EXPECT_LT(std::abs(rates[i] - s.rate(i, 0)), 0.01) << "sample " << i << " at " << s.t[i] << " s";
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    EXPECT_LT(std::abs(rates[i] - s.rate(i, 0)), 0.01) << "sample " << i << " at " << t[i] << " s";
   }
 }
 
