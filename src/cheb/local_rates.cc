@@ -63,6 +63,10 @@ constexpr double kNoisyLocalRates = 10.0;
 // largest ratio of its steps it is used over.
 constexpr Eigen::Index kOneSided = 5;
 constexpr double kOneSidedSpread = 1.5;
+// The stamps' resolution, whole nanoseconds (s). Steps are differences of stamps as seconds from
+// the first sample, and their rounding must not decide a comparison of steps at a ratio that a
+// grid with dropped samples meets exactly (Close; BuildRuns at 1.5, steps of 2h and 3h).
+constexpr double kStampResolution = 1e-9;
 // The one-sided rates at an end sample, as weights per 1/h on the end sample and the next ones at
 // even spacing: the quadratic's through three samples and the quintic's through six.
 constexpr std::array<double, 3> kOneSidedQuadratic{-1.5, 2.0, -0.5};
@@ -120,7 +124,6 @@ constexpr double kUnderResolved = 0.5;
 // sample without a slope (a 10 Hz hand-held recording with dropouts: 4.4 m/s off at its last
 // sample, where the motion is under 1 m/s).
 bool Close(const Eigen::VectorXd& h, Eigen::Index j) {
-  constexpr double kStampResolution = 1e-9;  // s
   const Eigen::Index n = h.size();
   double beside = std::numeric_limits<double>::infinity();
   if (j >= 1) beside = h[j - 1];
@@ -781,7 +784,7 @@ std::vector<LocalRun> BuildRuns(const Eigen::VectorXd& t, const Eigen::MatrixXd&
     const bool higher = five(i, c) || spline(i, c);
     auto even = [&](Eigen::Index from) {
       const auto steps = h.segment(from, kOneSided);
-      return steps.maxCoeff() <= kOneSidedSpread * steps.minCoeff();
+      return steps.maxCoeff() <= kOneSidedSpread * steps.minCoeff() + kStampResolution;
     };
     if (higher && i == 0 && n > kOneSided && usable.col(c).head(kOneSided).all() && even(0)) {
       return LagrangeRate(t, z, first, c, first, first + kOneSided);

@@ -44,11 +44,12 @@ Samples Smooth(Eigen::Index m, uint64_t seed) {
   return Smooth(Eigen::VectorXd::LinSpaced(m, 0.0, static_cast<double>(m - 1)) / kRate, seed);
 }
 
-// The rates of one run over every sample, each local with the 3-point rate.
-Eigen::VectorXd LocalRatesOf(const Samples& s) {
+// The rates of one run over every sample, each local with the 3-point rate (or with the 5-point
+// one, and at the ends the one-sided quintic, where `five`).
+Eigen::VectorXd LocalRatesOf(const Samples& s, bool five = false) {
   const Eigen::Index m = s.t.size();
   using Flags = Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>;
-  const LocalSamples chosen{Flags::Constant(m, 1, true), Flags::Constant(m, 1, false), Flags::Constant(m, 1, false),
+  const LocalSamples chosen{Flags::Constant(m, 1, true), Flags::Constant(m, 1, five), Flags::Constant(m, 1, false),
                             Flags::Constant(m, 1, false)};
   const Eigen::MatrixXd fit = Eigen::MatrixXd::Zero(m, 1);
   const std::vector<LocalRun> runs =
@@ -94,6 +95,22 @@ TEST(LocalRates, AStepBesideADroppedSampleKeepsItsSlope) {
   // The 3-point rates' bias on this motion at steps of 0.1–0.2 s is under 4 mm/s.
   for (Eigen::Index i = 0; i < t.size(); ++i) {
     EXPECT_LT(std::abs(rates[i] - s.rate(i, 0)), 0.01) << "sample " << i << " at " << t[i] << " s";
+  }
+}
+
+// At a segment's end, the one-sided quintic is used over steps within 1.5 of each other. A grid
+// with one and then two samples dropped puts steps of 2h and 3h there, exactly 1.5 apart, and the
+// steps' rounding must not decide: from the first sample of a 10 Hz grid, 0.5 − 0.2 s came out
+// above 1.5 · 0.2 s, and the end sample took the one-sided quadratic, 11 mm/s off on this motion
+// at both ends (the quintic's error here is under 0.5 mm/s).
+TEST(LocalRates, TheOneSidedQuinticDoesNotDependOnTheStepsRounding) {
+  const std::vector<int64_t> kept{0, 2, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 32, 34};
+  Eigen::VectorXd t(static_cast<Eigen::Index>(kept.size()));
+  for (Eigen::Index i = 0; i < t.size(); ++i) t[i] = static_cast<double>(kept[static_cast<size_t>(i)] * 100'000'000) * 1e-9;
+  const Samples s = Smooth(t, 1);
+  const Eigen::VectorXd rates = LocalRatesOf(s, /*five=*/true);
+  for (const Eigen::Index i : {Eigen::Index{0}, t.size() - 1}) {
+    EXPECT_LT(std::abs(rates[i] - s.rate(i, 0)), 0.003) << "sample " << i << " at " << t[i] << " s";
   }
 }
 
