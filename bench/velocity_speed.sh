@@ -40,7 +40,11 @@ if [[ -n "$baseline" ]] && ! cmp -s "$work/out.tum" "$work/baseline.tum"; then
 fi
 stats() { sort -n "$1" | awk '{ v[NR] = $1 } END { printf "%.4f %.4f", v[1], v[int((NR + 1) / 2)] }'; }
 lines=$(wc -l < "$work/in.tum")
-echo "samples: $lines, runs: $runs (alternating), seconds best / median; $(nproc) cores"
+# The fit's kernels take 8-wide vectors where the CPU has AVX-512 and 4-wide ones elsewhere
+# (docs/velocity.md, "Kernels"): figures from machines of the two kinds are not comparable.
+vectors=$(grep -q -m1 -w avx512f /proc/cpuinfo 2> /dev/null && echo "AVX-512" || echo "no AVX-512")
+cpu=$(grep -m1 "model name" /proc/cpuinfo 2> /dev/null | sed 's/.*: //' || true)
+echo "samples: $lines, runs: $runs (alternating), seconds best / median; $(nproc) cores, ${cpu:-unknown CPU}, $vectors"
 for kind in wall cpu; do
   read -r dbest dmed <<< "$(stats "$work/default.$kind")"
   read -r cbest cmed <<< "$(stats "$work/central.$kind")"
