@@ -44,6 +44,14 @@ Samples Smooth(Eigen::Index m, uint64_t seed) {
   return Smooth(Eigen::VectorXd::LinSpaced(m, 0.0, static_cast<double>(m - 1)) / kRate, seed);
 }
 
+// The samples `kept` of a 10 Hz grid, as the curve takes their stamps: whole nanoseconds, as
+// seconds from the first.
+Eigen::VectorXd GridStamps(const std::vector<int64_t>& kept) {
+  Eigen::VectorXd t(static_cast<Eigen::Index>(kept.size()));
+  for (Eigen::Index i = 0; i < t.size(); ++i) t[i] = static_cast<double>(kept[static_cast<size_t>(i)] * 100'000'000) * 1e-9;
+  return t;
+}
+
 // The rates of one run over every sample, each local with the 3-point rate (or with the 5-point
 // one, and at the ends the one-sided quintic, where `five`).
 Eigen::VectorXd LocalRatesOf(const Samples& s, bool five = false) {
@@ -88,8 +96,7 @@ TEST(LocalRates, AStepBesideADroppedSampleKeepsItsSlope) {
   for (int64_t k = 0; k <= 50; ++k) {
     if (k != 2 && k != 20 && k != 23 && k != 48) kept.push_back(k);
   }
-  Eigen::VectorXd t(static_cast<Eigen::Index>(kept.size()));
-  for (Eigen::Index i = 0; i < t.size(); ++i) t[i] = static_cast<double>(kept[static_cast<size_t>(i)] * 100'000'000) * 1e-9;
+  const Eigen::VectorXd t = GridStamps(kept);
   const Samples s = Smooth(t, 1);
   const Eigen::VectorXd rates = LocalRatesOf(s);
   // The 3-point rates' bias on this motion at steps of 0.1–0.2 s is under 4 mm/s.
@@ -105,8 +112,7 @@ TEST(LocalRates, AStepBesideADroppedSampleKeepsItsSlope) {
 // at both ends (the quintic's error here is under 0.5 mm/s).
 TEST(LocalRates, TheOneSidedQuinticDoesNotDependOnTheStepsRounding) {
   const std::vector<int64_t> kept{0, 2, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 32, 34};
-  Eigen::VectorXd t(static_cast<Eigen::Index>(kept.size()));
-  for (Eigen::Index i = 0; i < t.size(); ++i) t[i] = static_cast<double>(kept[static_cast<size_t>(i)] * 100'000'000) * 1e-9;
+  const Eigen::VectorXd t = GridStamps(kept);
   const Samples s = Smooth(t, 1);
   const Eigen::VectorXd rates = LocalRatesOf(s, /*five=*/true);
   for (const Eigen::Index i : {Eigen::Index{0}, t.size() - 1}) {
