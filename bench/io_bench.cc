@@ -76,6 +76,18 @@ void BM_FormatTum(benchmark::State& state) {
 }
 BENCHMARK(BM_FormatTum)->Arg(200'000)->Unit(benchmark::kMillisecond);
 
+// The block-by-block form the file writers use; in wall time, as its blocks are formatted on two threads.
+void BM_FormatTumBlocks(benchmark::State& state) {
+  const traj::Trajectory& trajectory = Motion(state.range(0));
+  for (auto _ : state) {
+    size_t bytes = 0;
+    traj::FormatTrajectory(trajectory.View(), traj::Format::kTum, [&](std::string_view block) { bytes += block.size(); });
+    benchmark::DoNotOptimize(bytes);
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+BENCHMARK(BM_FormatTumBlocks)->Arg(200'000)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void BM_ParseDecimalStamp(benchmark::State& state) {
   for (auto _ : state) {
     benchmark::DoNotOptimize(traj::ParseDecimalStamp("1403715529.112143517", 9));

@@ -1,6 +1,7 @@
 // Writers and readers agree (write -> read round trips are exact), detection picks the right
 // format, and the generic column map reads what it is told to.
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,21 @@ TEST(Formats, TumVelocityRoundTripIsExact) {
   EXPECT_EQ(truth.View().velocities(), back.View().velocities());
 }
 
+// What the sink throws (a full disk) comes out of FormatTrajectory, the worker joined.
+TEST(Formats, ASinkThatThrowsStopsTheBlocks) {
+  sim::MotionOptions options;
+  options.duration_s = 60.0;
+  options.rate_hz = 200.0;
+  const Trajectory truth = sim::GenerateMotion(options);
+  int blocks = 0;
+  EXPECT_THROW(FormatTrajectory(truth.View(), Format::kTum,
+                                [&](std::string_view) {
+                                  if (++blocks == 2) throw std::runtime_error("disk full");
+                                }),
+               std::runtime_error);
+  EXPECT_EQ(blocks, 2);
+}
+
 TEST(Formats, EurocRoundTripIsExact) {
   const Trajectory truth = Motion();
   const std::string text = FormatTrajectory(truth.View(), Format::kEuroc);
@@ -92,6 +108,8 @@ TEST(Formats, WriterRefusesWhatTheFormatCannotHold) {
 // The writers' blocks (about 1 MiB each, for outputs too large to hold whole) join to the text that
 // FormatTrajectory returns, in every format; a trajectory a format cannot hold throws before the
 // first block.
+// Every other block is formatted on a worker thread (with a second core): the blocks, handed over
+// in order, are the whole text, also with an odd number of them (tumv).
 TEST(Formats, BlocksJoinToTheWholeText) {
   sim::MotionOptions options;
   options.duration_s = 120.0;
