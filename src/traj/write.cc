@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <future>
 #include <span>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -149,21 +150,28 @@ void FormatTrajectory(const TrajectoryView& trajectory, Format format,
   if (paired) next.reserve(reserve);
   for (Eigen::Index begin = 0; begin < n; begin += paired ? 2 * rows : rows) {
     const Eigen::Index middle = std::min(n, begin + rows), end = std::min(n, middle + rows);
+    const bool second = paired && middle < end;
+    auto format_second = [&, middle, end] {
+      next.clear();
+      AppendRows(trajectory, format, middle, end, next);
+    };
     // Declared after the blocks: its destructor waits for the worker before they go.
     std::future<void> worker;
-    if (paired && middle < end) {
-      worker = std::async(std::launch::async, [&, middle, end] {
-        next.clear();
-        AppendRows(trajectory, format, middle, end, next);
-      });
+    if (second) {
+      try {
+        worker = std::async(std::launch::async, format_second);
+      } catch (const std::system_error&) {  // no thread to be had: the caller formats it below
+      }
     }
     block.clear();
     AppendRows(trajectory, format, begin, middle, block);
     sink(block);
     if (worker.valid()) {
       worker.get();
-      sink(next);
+    } else if (second) {
+      format_second();
     }
+    if (second) sink(next);
   }
 }
 
