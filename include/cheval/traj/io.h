@@ -131,7 +131,9 @@ std::vector<int64_t> ReadStampsFile(const std::string& path);
 std::string FormatTrajectory(const TrajectoryView& trajectory, Format format);
 
 /// FormatTrajectory's text handed to `sink` a block of about 1 MiB at a time, for an output too large
-/// to hold whole (OutputFile::write). Every check is made, and throws, before the first block.
+/// to hold whole (OutputFile::write). Every check is made, and throws, before the first block. The
+/// blocks come in order on the caller's thread; with a second core, a worker thread formats the next
+/// one meanwhile, so `sink` must not change the trajectory. What `sink` throws ends the call.
 void FormatTrajectory(const TrajectoryView& trajectory, Format format,
                       const std::function<void(std::string_view)>& sink);
 
